@@ -1,0 +1,67 @@
+//! `infiniterra bench`: numbers for this machine — the engine's own overhead per window
+//! with a trivial Φ, and the pipeline's throughput for the stages that exist.
+//!
+//! Every figure is the median of several runs at different places of the world (fresh
+//! pipelines, so "cold" really is cold). Speed targets live here, never in timed tests.
+
+mod engine;
+mod pipeline;
+
+use clap::Args;
+use serde::Serialize;
+
+use crate::config::Config;
+
+/// Arguments of `infiniterra bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Runs per measurement (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
+}
+
+/// One measured quantity.
+#[derive(Debug, Clone, Serialize)]
+pub struct Measurement {
+    /// What was measured.
+    pub name: String,
+    /// Median over the runs.
+    pub value: f64,
+    /// Unit of `value`.
+    pub unit: &'static str,
+    /// Every run's value.
+    pub runs: Vec<f64>,
+}
+
+impl Measurement {
+    /// Builds a measurement from the runs' values.
+    pub fn new(name: &str, unit: &'static str, mut runs: Vec<f64>) -> Measurement {
+        let mut sorted = runs.clone();
+        sorted.sort_by(f64::total_cmp);
+        let value = sorted.get(sorted.len() / 2).copied().unwrap_or(f64::NAN);
+        runs.shrink_to_fit();
+        Measurement { name: name.to_string(), value, unit, runs }
+    }
+}
+
+/// Runs the suite and prints it.
+pub fn run(config: &Config, args: &BenchArgs) -> anyhow::Result<()> {
+    let runs = args.runs.max(1);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut all = engine::measure(runs);
+    all.extend(pipeline::measure(config, runs));
+    if args.json {
+        let doc = serde_json::json!({ "machine_threads": threads, "seed": config.world.seed, "measurements": all });
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        println!("infiniterra bench — {threads} hardware threads, seed {}, median of {runs} runs", config.world.seed);
+        println!("{:<58} {:>14}  {}", "measurement", "median", "unit");
+        for m in &all {
+            println!("{:<58} {:>14.3}  {}", m.name, m.value, m.unit);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,95 @@
+//! `render` and `export`: maps and raw heightmaps of any rectangle.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::progress::Progress;
+use super::{Failure, Size};
+use crate::config::Config;
+use crate::export::{self, ExportRequest, Grid, Vertical};
+use crate::render::{self, Layer, RenderRequest};
+use crate::terrain::Pipeline;
+
+/// Arguments of `infiniterra render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// West edge, block x.
+    #[arg(long, allow_hyphen_values = true)]
+    pub x0: i64,
+    /// North edge, block z.
+    #[arg(long, allow_hyphen_values = true)]
+    pub z0: i64,
+    /// Size in blocks: `W` or `WxH`.
+    #[arg(long)]
+    pub size: Size,
+    /// Blocks per image pixel.
+    #[arg(long, default_value_t = 1)]
+    pub zoom: i64,
+    /// What to draw: elevation, temperature, precipitation, seasonality, variability, biome.
+    #[arg(long, default_value = "elevation")]
+    pub layer: Layer,
+    /// Output PNG.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Arguments of `infiniterra export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// West edge, block x.
+    #[arg(long, allow_hyphen_values = true)]
+    pub x0: i64,
+    /// North edge, block z.
+    #[arg(long, allow_hyphen_values = true)]
+    pub z0: i64,
+    /// Size in blocks: `W` or `WxH`.
+    #[arg(long)]
+    pub size: Size,
+    /// `block`: one value per block column; `model`: one per model pixel (4×4 blocks).
+    #[arg(long, default_value = "block")]
+    pub grid: Grid,
+    /// Output `.npy` (a `.json` with the same stem is written beside it).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn pipeline(config: &Config) -> Pipeline {
+    Pipeline::new(config.world.seed, &config.terrain())
+}
+
+/// Runs `render`.
+pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
+    if a.zoom < 1 {
+        return Err(Failure::input(anyhow::anyhow!("--zoom {} is out of range (allowed 1 or more)", a.zoom)));
+    }
+    let req = RenderRequest { x0: a.x0, z0: a.z0, width: a.size.width, height: a.size.height, zoom: a.zoom, layer: a.layer };
+    let pipeline = pipeline(config);
+    let mut progress = Progress::new("render", "rows");
+    let image = render::render(&pipeline, &req, &mut |d, t| progress.update(d, t)).map_err(Failure::input)?;
+    progress.finish();
+    image.save(&a.out).map_err(|e| Failure::runtime(anyhow::anyhow!("writing {}: {e}", a.out.display())))?;
+    println!("wrote {} ({}×{} px)", a.out.display(), image.width(), image.height());
+    Ok(())
+}
+
+/// Runs `export`.
+pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
+    let req = ExportRequest { x0: a.x0, z0: a.z0, width: a.size.width, height: a.size.height, grid: a.grid };
+    let vertical = Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
+    let pipeline = pipeline(config);
+    let mut progress = Progress::new("export", "rows");
+    let summary =
+        export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t)).map_err(Failure::runtime)?;
+    progress.finish();
+    println!(
+        "wrote {} ({}×{}, {:.1}..{:.1} m) and {}",
+        summary.npy.display(),
+        summary.shape.1,
+        summary.shape.0,
+        summary.min,
+        summary.max,
+        summary.json.display()
+    );
+    Ok(())
+}

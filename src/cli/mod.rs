@@ -1,0 +1,131 @@
+//! The command line (DESIGN §8): parsing, loading the configuration, dispatching to the
+//! subcommands, and turning errors into exit codes (0 ok, 1 runtime failure, 2 bad usage
+//! or bad input).
+
+mod args;
+mod maps;
+mod progress;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::config::{Config, DEFAULT_PATH};
+
+pub use args::Size;
+
+/// infiniterra: a Minecraft world generator with learned, infinite, seed-consistent terrain.
+#[derive(Debug, Parser)]
+#[command(name = "infiniterra", version, about, propagate_version = true)]
+pub struct Cli {
+    /// Configuration file.
+    #[arg(long, global = true, default_value = DEFAULT_PATH)]
+    pub config: PathBuf,
+    /// World seed (overrides `[world] seed`).
+    #[arg(long, global = true)]
+    pub seed: Option<u64>,
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run the Minecraft server (Java Edition 1.20.1).
+    Serve,
+    /// Draw a map of any rectangle of the world as a PNG.
+    Render(maps::RenderArgs),
+    /// Write raw elevation (float32 metres, .npy) of a rectangle, with a JSON sidecar.
+    Export(maps::ExportArgs),
+    /// Fetch or prepare the real elevation data the models learn from.
+    Data {
+        /// `fetch` or `prepare`.
+        action: String,
+    },
+    /// Measure how realistic generated terrain is against real terrain.
+    Eval {
+        /// Any further arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        rest: Vec<String>,
+    },
+    /// Train a stage of the model hierarchy.
+    Train {
+        /// Any further arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        rest: Vec<String>,
+    },
+    /// Pre-generate a region into Anvil files without a server.
+    Pregen {
+        /// Any further arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        rest: Vec<String>,
+    },
+    /// Measure the engine and the pipeline on this machine.
+    Bench(crate::bench::BenchArgs),
+}
+
+/// A failure with the exit code it maps to.
+#[derive(Debug)]
+pub struct Failure {
+    /// 1 runtime failure, 2 bad usage or bad input.
+    pub code: u8,
+    /// What went wrong.
+    pub error: anyhow::Error,
+}
+
+impl Failure {
+    /// Bad usage or bad input (exit 2).
+    pub fn input(error: impl Into<anyhow::Error>) -> Failure {
+        Failure { code: 2, error: error.into() }
+    }
+
+    /// Anything else (exit 1).
+    pub fn runtime(error: impl Into<anyhow::Error>) -> Failure {
+        Failure { code: 1, error: error.into() }
+    }
+}
+
+/// Parses the command line, runs it, prints any error and returns the exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {:#}", f.error);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+/// Loads the configuration named on the command line, applying `--seed`.
+pub fn load_config(cli: &Cli) -> Result<Config, Failure> {
+    let mut config = Config::load(&cli.config).map_err(Failure::input)?;
+    if let Some(seed) = cli.seed {
+        config.world.seed = seed;
+    }
+    Ok(config)
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<(), Failure> {
+    match &cli.command {
+        Command::Serve => not_yet("serve", 5, "the Minecraft server"),
+        Command::Render(a) => maps::render(&load_config(&cli)?, a),
+        Command::Export(a) => maps::export(&load_config(&cli)?, a),
+        Command::Data { action } => match action.as_str() {
+            "fetch" | "prepare" => not_yet(&format!("data {action}"), 3, "real elevation data"),
+            other => Err(Failure::input(anyhow::anyhow!("unknown data action {other:?}: use `fetch` or `prepare`"))),
+        },
+        Command::Eval { .. } => not_yet("eval", 3, "the realism report"),
+        Command::Train { .. } => not_yet("train", 4, "learned terrain"),
+        Command::Pregen { .. } => not_yet("pregen", 6, "pre-generation and Anvil persistence"),
+        Command::Bench(a) => crate::bench::run(&load_config(&cli)?, a).map_err(Failure::runtime),
+    }
+}
+
+/// Commands that a later issue delivers: say so and fail, never pretend.
+fn not_yet(command: &str, issue: u32, what: &str) -> Result<(), Failure> {
+    Err(Failure::runtime(anyhow::anyhow!("`infiniterra {command}` is not built yet: {what} arrives with issue #{issue}")))
+}

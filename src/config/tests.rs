@@ -1,0 +1,48 @@
+use std::path::Path;
+
+use super::*;
+
+fn parse(text: &str) -> Result<Config, ConfigError> {
+    Config::parse(text, Path::new("config/test.toml"))
+}
+
+#[test]
+fn the_shipped_config_is_valid_and_matches_the_defaults_it_documents() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_PATH);
+    let shipped = Config::load(&path).expect("config/server.toml must load");
+    assert_eq!(shipped.layout, LayoutSettings::default());
+    assert_eq!(shipped.climate, ClimateSettings::default());
+    assert_eq!(shipped.engine, EngineSettings::default());
+    assert_eq!(shipped.server, ServerSettings::default());
+}
+
+#[test]
+fn an_out_of_range_value_names_file_line_key_and_range() {
+    let err = parse("[world]\nseed = 3\n\n[layout]\n# comment\nocean_fraction = 1.7\n").unwrap_err().to_string();
+    assert_eq!(err, "config/test.toml:6: layout.ocean_fraction = 1.7 is out of range (allowed 0..=0.95)");
+}
+
+#[test]
+fn unknown_keys_and_wrong_types_are_errors_with_lines() {
+    let err = parse("[climate]\nlapse_rate = 6.5\n").unwrap_err().to_string();
+    assert!(err.starts_with("config/test.toml:2:") && err.contains("lapse_rate"), "{err}");
+    let err = parse("[engine]\n\ncache_mib = \"lots\"\n").unwrap_err().to_string();
+    assert!(err.starts_with("config/test.toml:3:") && err.contains("\"lots\""), "{err}");
+    let err = parse("[server\nbind = 1").unwrap_err().to_string();
+    assert!(err.starts_with("config/test.toml:1:"), "{err}");
+}
+
+#[test]
+fn structural_world_values_are_checked() {
+    let err = parse("[world]\nmin_y = -60\n").unwrap_err().to_string();
+    assert!(err.contains("world.min_y = -60") && err.contains("multiple of 16"), "{err}");
+    let err = parse("[world]\nsea_level_y = 400\n").unwrap_err().to_string();
+    assert!(err.contains("config/test.toml:2: world.sea_level_y = 400"), "{err}");
+    let err = parse("[server]\nbind = \"localhost\"\n").unwrap_err().to_string();
+    assert!(err.contains("server.bind") && err.contains("IP address and port"), "{err}");
+}
+
+#[test]
+fn an_empty_file_means_every_default() {
+    assert_eq!(parse("").unwrap(), Config::default());
+}

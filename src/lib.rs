@@ -1,0 +1,14 @@
+//! infiniterra: a Minecraft world-generator server whose terrain is learned, infinite and
+//! seed-consistent.
+//!
+//! This crate is the owner-facing edge: configuration, the command line, maps and exports,
+//! benchmarks and (later) the Minecraft server. The terrain itself lives in the
+//! `infiniterra-terrain` crate, which knows nothing of Minecraft.
+
+pub mod bench;
+pub mod cli;
+pub mod config;
+pub mod export;
+pub mod render;
+
+pub use infiniterra_terrain as terrain;

@@ -1,0 +1,159 @@
+//! The pipeline facade: one call answers "elevation (m) and the four climate values for
+//! every block column of this rectangle".
+//!
+//! Owns: the stage list (coarse → core → detail, as data), the grids they live on, the 4×
+//! upsampling from model pixels to blocks. Must not touch: Minecraft (block ids, biomes,
+//! chunks) — callers map metres and climate to blocks themselves.
+
+mod stages;
+
+use std::sync::Arc;
+
+pub use stages::{StageState, StageStatus};
+
+use crate::climate::{precipitation, temperature_at, Orographic};
+use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
+use crate::layout::{sketch, Layout};
+use crate::settings::TerrainSettings;
+use crate::tile::{Rect, Tile};
+use crate::upsample;
+
+/// Minecraft blocks per model pixel (horizontally), whatever the model's real resolution.
+pub const BLOCKS_PER_MODEL_PIXEL: i64 = 4;
+/// Real size of one model pixel, metres (the final stage's training resolution).
+pub const MODEL_PIXEL_METRES: f64 = 500.0;
+/// Model pixels per coarse pixel (the coarse grid: continents, shelves, climate).
+pub const COARSE_FACTOR: i64 = 16;
+
+/// Channels of every pipeline answer.
+pub mod channel {
+    /// Elevation, metres above sea level (negative under the sea).
+    pub const ELEVATION: usize = 0;
+    /// Annual mean air temperature at the surface, °C.
+    pub const TEMPERATURE: usize = 1;
+    /// Temperature seasonality: standard deviation of monthly means, °C.
+    pub const SEASONALITY: usize = 2;
+    /// Annual precipitation, mm.
+    pub const PRECIPITATION: usize = 3;
+    /// Precipitation variability (coefficient of variation), %.
+    pub const VARIABILITY: usize = 4;
+    /// Number of channels.
+    pub const COUNT: usize = 5;
+    /// Channel names, in order, for files and legends.
+    pub const NAMES: [&str; COUNT] = ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct"];
+}
+
+/// The terrain pipeline for one seed: thread-safe, shared by every chunk worker.
+pub struct Pipeline {
+    seed: u64,
+    settings: TerrainSettings,
+    engine: Arc<Engine>,
+    stages: Vec<StageStatus>,
+    elevation: Arc<dyn Source>,
+    coarse_elevation: Arc<dyn Source>,
+    coarse_sketch: Arc<dyn Source>,
+    precipitation: Arc<Windowed>,
+}
+
+impl Pipeline {
+    /// Builds the pipeline of `seed` with validated `settings`.
+    pub fn new(seed: u64, settings: &TerrainSettings) -> Pipeline {
+        let engine = Engine::new(EngineConfig {
+            cache_bytes: (settings.engine.cache_mib as usize) << 20,
+            threads: settings.engine.threads as usize,
+        });
+        let layout = Layout::new(seed, &settings.layout);
+        let coarse_metres = MODEL_PIXEL_METRES * COARSE_FACTOR as f64;
+        let coarse_elevation: Arc<dyn Source> = Arc::new(layout.elevation(coarse_metres));
+        let coarse_sketch: Arc<dyn Source> = Arc::new(layout.climate_sketch(coarse_metres));
+        let precipitation = Windowed::new(
+            &engine,
+            Orographic {
+                elevation: coarse_elevation.clone(),
+                sketch: coarse_sketch.clone(),
+                settings: settings.climate.clone(),
+                pixel_metres: coarse_metres,
+                layout: WindowLayout::square(32, 16, 0),
+                margin: 16,
+            },
+        );
+        let elevation: Arc<dyn Source> = Arc::new(layout.elevation(MODEL_PIXEL_METRES));
+        Pipeline {
+            seed,
+            settings: settings.clone(),
+            engine,
+            stages: stages::current(),
+            elevation,
+            coarse_elevation,
+            coarse_sketch,
+            precipitation,
+        }
+    }
+
+    /// The world seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The settings it was built with.
+    pub fn settings(&self) -> &TerrainSettings {
+        &self.settings
+    }
+
+    /// Every stage of the hierarchy and whether it runs.
+    pub fn stages(&self) -> &[StageStatus] {
+        &self.stages
+    }
+
+    /// Names of the stages that ran to produce answers (for file metadata and logs).
+    pub fn active_stages(&self) -> Vec<String> {
+        self.stages.iter().filter(|s| s.state == StageState::Active).map(|s| s.name.to_string()).collect()
+    }
+
+    /// The engine's counters (cache use, windows evaluated).
+    pub fn engine_stats(&self) -> EngineStats {
+        self.engine.stats()
+    }
+
+    /// The shared engine (cache size, thread count).
+    pub fn engine(&self) -> &Arc<Engine> {
+        &self.engine
+    }
+
+    /// All channels (see [`channel`]) on the model grid, one value per model pixel.
+    pub fn model(&self, rect: Rect) -> Tile {
+        let elevation = self.elevation.query(rect);
+        let coarse = upsample::source_rect(&rect, COARSE_FACTOR);
+        let sketch = upsample::bilinear(&self.coarse_sketch.query(coarse), COARSE_FACTOR, rect);
+        let rain = upsample::bilinear(&self.precipitation.query(coarse), COARSE_FACTOR, rect);
+
+        let n = rect.area();
+        let mut out = Tile::zeros(channel::COUNT, rect);
+        let lapse = self.settings.climate.lapse_rate_c_per_km as f32;
+        let offset = self.settings.climate.temperature_offset_c as f32;
+        let t0 = sketch.channel(sketch::SEA_LEVEL_TEMPERATURE);
+        for (i, &e) in elevation.data.iter().enumerate() {
+            out.data[channel::ELEVATION * n + i] = e;
+            out.data[channel::TEMPERATURE * n + i] = temperature_at(t0[i] + offset, e, lapse);
+        }
+        out.channel_mut(channel::SEASONALITY).copy_from_slice(sketch.channel(sketch::SEASONALITY));
+        out.channel_mut(channel::PRECIPITATION).copy_from_slice(rain.channel(precipitation::ANNUAL_MM));
+        out.channel_mut(channel::VARIABILITY).copy_from_slice(rain.channel(precipitation::VARIABILITY_PCT));
+        out
+    }
+
+    /// All channels for every block column of `blocks` (y = z, x = x in block coordinates),
+    /// bilinearly upsampled 4× from the model grid.
+    pub fn columns(&self, blocks: Rect) -> Tile {
+        let model = self.model(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
+        upsample::bilinear(&model, BLOCKS_PER_MODEL_PIXEL, blocks)
+    }
+
+    /// Coarse elevation (metres) of the coarse cell holding a block column: cheap, for
+    /// searching a spawn point or a region's character without running the full pipeline.
+    pub fn coarse_elevation_at_block(&self, x: i64, z: i64) -> f32 {
+        let f = BLOCKS_PER_MODEL_PIXEL * COARSE_FACTOR;
+        let (cy, cx) = (crate::tile::div_floor(z, f), crate::tile::div_floor(x, f));
+        self.coarse_elevation.query(Rect::new(cy, cx, 1, 1)).data[0]
+    }
+}
