@@ -15,9 +15,9 @@ use serde::Deserialize;
 
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::settings::{check_range, RangeError};
-use crate::tile::Tile;
+use crate::tile::{Rect, Tile};
 
-pub use orographic::{variability_pct, wind_vector};
+pub use orographic::{upwind_pad, variability_pct, wind_vector};
 
 /// Owner knobs of the climate model (`[climate]` in `config/server.toml`).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -108,18 +108,22 @@ impl WindowFn for Orographic {
 }
 
 impl Orographic {
-    /// Precipitation over one window: solved on the window padded by `margin` cells so air
-    /// arriving at the window already carries its upwind history, then cropped. Depends on
-    /// the window and the (pure) input sources only.
+    /// Precipitation over one window: solved on the window padded by `margin` cells on its
+    /// upwind sides (see [`upwind_pad`]), so air arriving at the window already carries its
+    /// upwind history, then cropped. Depends on the window and the (pure) inputs only.
     fn window(&self, w: WindowIndex) -> Tile {
         let core = self.layout.rect(w);
-        let padded = core.pad(self.margin.max(0));
+        self.solve_over(upwind_pad(core, self.margin, self.settings.wind_from_deg), core)
+    }
+
+    /// Solves the sweep over `padded` and returns the part over `core` (inside it).
+    fn solve_over(&self, padded: Rect, core: Rect) -> Tile {
         let elevation = self.elevation.query(padded);
         let sketch = self.sketch.query(padded);
         let base = sketch.channel(crate::layout::sketch::BASE_PRECIPITATION);
-        let (h, wd) = (padded.h as usize, padded.w as usize);
-        let planes = orographic::solve(elevation.channel(0), base, h, wd, &self.settings, self.pixel_metres);
-        orographic::to_tile(planes, padded).crop(core)
+        let (h, w) = (padded.h as usize, padded.w as usize);
+        let annual = orographic::solve(elevation.channel(0), base, h, w, &self.settings, self.pixel_metres);
+        orographic::to_tile(annual, self.settings.precipitation_scale, padded).crop(core)
     }
 }
 

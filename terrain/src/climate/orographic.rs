@@ -2,7 +2,7 @@
 //! first-order upwind sweep, rained out by uplift, recharged over the sea.
 
 use super::{precipitation, ClimateSettings};
-use crate::tile::Tile;
+use crate::tile::{Rect, Tile};
 
 /// Extra precipitation per unit of uplift slope at strength 1: a 1000 m rise over 20 km
 /// (slope 0.05) triples precipitation (1 + 40 · 0.05 = 3).
@@ -11,9 +11,12 @@ const UPLIFT_GAIN: f64 = 40.0;
 /// air crossing a 2000 m ridge keeps ~60 %, so the lee gets about a third of the windward
 /// slope's rain and half of the upwind plain's.
 const RAINOUT_RISE_M: f64 = 4_000.0;
-/// Distance over which air loses 1 − 1/e of its moisture over land without uplift
-/// (continental interiors are drier).
-const LAND_DRYING_M: f64 = 2_000_000.0;
+/// Moisture that air settles to over flat land, far from the sea: evaporation from the
+/// land recycles some rain, so it dries (from 1) or recovers (from a rain shadow) toward it.
+const LAND_EQUILIBRIUM: f64 = 0.8;
+/// Distance over which air over land moves 1 − 1/e of the way to [`LAND_EQUILIBRIUM`]: rain
+/// shadows fade over several hundred km, so a window margin of that order sees them.
+const LAND_RELAX_M: f64 = 500_000.0;
 /// Distance over which air over the sea recovers 1 − 1/e of its missing moisture.
 const SEA_RECHARGE_M: f64 = 400_000.0;
 
@@ -21,10 +24,19 @@ const SEA_RECHARGE_M: f64 = 400_000.0;
 /// `from_deg` clockwise from north (north = −y, east = +x).
 pub fn wind_vector(from_deg: f64) -> (f64, f64) {
     let a = from_deg.to_radians();
-    let (dx, dy) = (-a.sin(), a.cos());
     // Snap round-off (e.g. cos 90° ≈ 6e-17) so axis-aligned winds stay exactly 1-D.
     let snap = |v: f64| if v.abs() < 1e-9 { 0.0 } else { v };
-    (snap(dx), snap(dy))
+    (snap(-a.sin()), snap(a.cos()))
+}
+
+/// `core` grown by `margin` cells on its upwind sides only. Moisture flows downwind, so no
+/// cell of `core` depends on anything downwind or beside this rectangle: the result is
+/// identical to padding every side, at a fraction of the cost.
+pub fn upwind_pad(core: Rect, margin: i64, from_deg: f64) -> Rect {
+    let (dx, dy) = wind_vector(from_deg);
+    let m = margin.max(0);
+    let side = |upwind: bool| if upwind { m } else { 0 };
+    core.pad_sides(side(dy > 0.0), side(dy < 0.0), side(dx > 0.0), side(dx < 0.0))
 }
 
 /// Inter-annual variability (%) for an annual precipitation (mm): drier climates vary more
@@ -33,69 +45,84 @@ pub fn variability_pct(annual_mm: f64) -> f64 {
     (10.0 + 70.0 * (-annual_mm / 300.0).exp()).clamp(5.0, 80.0)
 }
 
-/// Precipitation and variability over a padded window, given its elevation (m) and base
-/// precipitation (mm/yr) planes, `h × w` row-major.
-pub(crate) fn solve(elevation: &[f32], base: &[f32], h: usize, w: usize, s: &ClimateSettings, pixel_m: f64) -> [Vec<f32>; 2] {
+/// The per-cell constants of one sweep.
+struct Sweep {
+    /// |dx|, |dy| of the wind: weights of the upwind x and y neighbours.
+    ax: f64,
+    ay: f64,
+    pixel_m: f64,
+    strength: f64,
+    /// Fraction of the land-equilibrium gap kept per cell, and of the sea gap recharged.
+    land_keep: f64,
+    sea_recharge: f64,
+}
+
+impl Sweep {
+    /// One cell given the moisture arriving (`q_in`), the rise along the wind over the cell
+    /// (m), its base precipitation and whether it is sea: (precipitation, moisture leaving).
+    fn cell(&self, q_in: f64, rise: f64, base: f64, sea: bool) -> (f64, f64) {
+        if sea {
+            return (base * q_in, q_in + (1.0 - q_in) * self.sea_recharge);
+        }
+        let uplift = (rise / self.pixel_m).max(0.0);
+        let rain = base * q_in * (1.0 + self.strength * UPLIFT_GAIN * uplift);
+        // Rain-out is proportional to the extra orographic rain (∝ the rise climbed).
+        let q_out = q_in * (-self.strength * rise.max(0.0) / RAINOUT_RISE_M).exp();
+        (rain, LAND_EQUILIBRIUM + (q_out - LAND_EQUILIBRIUM) * self.land_keep)
+    }
+}
+
+/// Annual precipitation (mm, before the owner's scale) over a padded window, given its
+/// elevation (m) and base precipitation (mm/yr) planes, `h × w` row-major.
+pub(crate) fn solve(
+    elevation: &[f32],
+    base: &[f32],
+    h: usize,
+    w: usize,
+    s: &ClimateSettings,
+    pixel_m: f64,
+) -> Vec<f32> {
     let (dx, dy) = wind_vector(s.wind_from_deg);
-    let (ax, ay) = (dx.abs(), dy.abs());
-    let (sx, sy) = (dx < 0.0, dy < 0.0);
-    let strength = s.orographic_strength;
-    let land_keep = (-pixel_m / LAND_DRYING_M).exp();
-    let sea_recharge = 1.0 - (-pixel_m / SEA_RECHARGE_M).exp();
+    let sweep = Sweep {
+        ax: dx.abs(),
+        ay: dy.abs(),
+        pixel_m,
+        strength: s.orographic_strength,
+        land_keep: (-pixel_m / LAND_RELAX_M).exp(),
+        sea_recharge: 1.0 - (-pixel_m / SEA_RECHARGE_M).exp(),
+    };
+    // Visit rows and columns in the wind's direction so upwind neighbours come first.
+    let order = |n: usize, reverse: bool| (0..n).map(move |k| if reverse { n - 1 - k } else { k });
+    let upwind = |i: usize, reverse: bool| if reverse { i + 1 } else { i.wrapping_sub(1) };
+    let ground = |i: usize| f64::from(elevation[i]).max(0.0); // the sea surface is flat
     let mut q = vec![1.0f64; h * w];
     let mut annual = vec![0.0f32; h * w];
-    // Visit rows and columns in the wind's direction so upwind neighbours come first.
-    for ky in 0..h {
-        let y = if sy { h - 1 - ky } else { ky };
-        let up_y = if sy { y + 1 } else { y.wrapping_sub(1) };
-        for kx in 0..w {
-            let x = if sx { w - 1 - kx } else { kx };
-            let up_x = if sx { x + 1 } else { x.wrapping_sub(1) };
-            let i = y * w + x;
-            // Outside the padded window the air is saturated (q = 1) and the ground flat.
-            let ux = (up_x < w).then(|| y * w + up_x);
-            let uy = (up_y < h).then(|| up_y * w + x);
-            let upwind_q = |j: Option<usize>| j.map_or(1.0, |j| q[j]);
-            let ground = |j: Option<usize>| surface(elevation[j.unwrap_or(i)]);
-            let q_in = (ax * upwind_q(ux) + ay * upwind_q(uy)) / (ax + ay);
-            let here = ground(None);
-            // Rise along the wind over one cell: the upwind difference of the wind-weighted slope.
-            let rise = ax * (here - ground(ux)) + ay * (here - ground(uy));
-            let b = f64::from(base[i]).max(0.0);
-            if elevation[i] <= 0.0 {
-                q[i] = q_in + (1.0 - q_in) * sea_recharge;
-                annual[i] = (b * q_in) as f32;
-            } else {
-                let uplift = (rise / pixel_m).max(0.0);
-                annual[i] = (b * q_in * (1.0 + strength * UPLIFT_GAIN * uplift)) as f32;
-                // Rain-out is proportional to the extra orographic rain (∝ the rise climbed).
-                q[i] = q_in * (-strength * rise.max(0.0) / RAINOUT_RISE_M).exp() * land_keep;
-            }
+    for y in order(h, dy < 0.0) {
+        let up_y = upwind(y, dy < 0.0);
+        for x in order(w, dx < 0.0) {
+            let (i, up_x) = (y * w + x, upwind(x, dx < 0.0));
+            // Outside the padded window the air is saturated (q = 1) and the ground level.
+            let ux = if up_x < w { y * w + up_x } else { i };
+            let uy = if up_y < h { up_y * w + x } else { i };
+            let q_at = |j: usize| if j == i { 1.0 } else { q[j] };
+            let q_in = (sweep.ax * q_at(ux) + sweep.ay * q_at(uy)) / (sweep.ax + sweep.ay);
+            // Rise along the wind over one cell: upwind differences weighted by the wind.
+            let rise = sweep.ax * (ground(i) - ground(ux)) + sweep.ay * (ground(i) - ground(uy));
+            let (rain, q_out) = sweep.cell(q_in, rise, f64::from(base[i]).max(0.0), elevation[i] <= 0.0);
+            annual[i] = rain as f32;
+            q[i] = q_out;
         }
     }
-    finish(annual, s.precipitation_scale)
+    annual
 }
 
-/// The sea surface is flat: air rises over land only.
-fn surface(e: f32) -> f64 {
-    f64::from(e).max(0.0)
-}
-
-/// Applies the owner's scale and derives the variability channel.
-fn finish(mut annual: Vec<f32>, scale: f64) -> [Vec<f32>; 2] {
+/// Applies the owner's scale, derives the variability channel and stacks both into a tile
+/// over `rect` (channel order of [`precipitation`]).
+pub(crate) fn to_tile(mut annual: Vec<f32>, scale: f64, rect: Rect) -> Tile {
     for v in &mut annual {
         *v = (f64::from(*v) * scale).max(0.0) as f32;
     }
-    let variability = annual.iter().map(|&p| variability_pct(f64::from(p)) as f32).collect();
-    [annual, variability]
-}
-
-/// Stacks the two output planes into a tile over `rect` (channel order of
-/// [`precipitation`]).
-pub(crate) fn to_tile(planes: [Vec<f32>; 2], rect: crate::tile::Rect) -> Tile {
-    let [annual, variability] = planes;
-    let mut data = Vec::with_capacity(precipitation::CHANNELS * rect.area());
-    data.extend_from_slice(&annual);
-    data.extend_from_slice(&variability);
-    Tile::from_data(precipitation::CHANNELS, rect, data)
+    let variability: Vec<f32> = annual.iter().map(|&p| variability_pct(f64::from(p)) as f32).collect();
+    annual.extend_from_slice(&variability);
+    Tile::from_data(precipitation::CHANNELS, rect, annual)
 }

@@ -41,19 +41,38 @@ impl Source for FlatSketch {
     }
 }
 
+/// Hills and sea basins varying along both axes, for checks any wind direction exercises.
+struct Bumps;
+
+impl Source for Bumps {
+    fn channels(&self) -> usize {
+        1
+    }
+    fn query(&self, rect: Rect) -> Tile {
+        let mut data = Vec::with_capacity(rect.area());
+        for y in rect.y0..rect.y1() {
+            for x in rect.x0..rect.x1() {
+                data.push((300.0 + 1500.0 * (x as f64 / 7.0).sin() * (y as f64 / 5.0).cos()) as f32);
+            }
+        }
+        Tile::from_data(1, rect, data)
+    }
+}
+
+fn orographic(elevation: Arc<dyn Source>, wind_from_deg: f64) -> Orographic {
+    Orographic {
+        elevation,
+        sketch: Arc::new(FlatSketch),
+        settings: ClimateSettings { wind_from_deg, ..Default::default() },
+        pixel_metres: PIXEL_M,
+        layout: WindowLayout::square(32, 16, 0),
+        margin: 64,
+    }
+}
+
 fn precipitation_across_ridge(wind_from_deg: f64) -> Vec<f32> {
     let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 1 });
-    let tensor = Windowed::new(
-        &engine,
-        Orographic {
-            elevation: Arc::new(Ridge),
-            sketch: Arc::new(FlatSketch),
-            settings: ClimateSettings { wind_from_deg, ..Default::default() },
-            pixel_metres: PIXEL_M,
-            layout: WindowLayout::square(32, 16, 0),
-            margin: 64,
-        },
-    );
+    let tensor = Windowed::new(&engine, orographic(Arc::new(Ridge), wind_from_deg));
     let t = tensor.query(Rect::new(-3, -60, 4, 120));
     assert!(t.data.iter().all(|v| v.is_finite()));
     // One row, west to east (x = −60 … 59); rows are identical for a north–south ridge.
@@ -73,6 +92,7 @@ fn band(p: &[f32], x0: i64, x1: i64) -> f32 {
 fn westerly_wind_wets_the_west_slope_and_dries_the_east() {
     let p = precipitation_across_ridge(270.0);
     let (plain, windward, lee) = (band(&p, -60, -50), band(&p, -8, -2), band(&p, 2, 8));
+    println!("westerly: upwind plain {plain:.0}, windward slope {windward:.0}, lee {lee:.0} mm/yr");
     assert!(windward > 2.0 * lee, "windward {windward} vs lee {lee} mm");
     assert!(windward > 1.3 * plain, "windward {windward} vs upwind plain {plain} mm");
     assert!(lee < 0.8 * plain, "lee {lee} vs upwind plain {plain} mm");
@@ -113,5 +133,30 @@ fn temperature_follows_the_lapse_rate_above_sea_level_only() {
     }
     for h in [-1.0f32, -200.0, -5000.0] {
         assert_eq!(temperature_at(20.0, h, lapse), 20.0, "no lapse below sea level ({h} m)");
+    }
+}
+
+#[test]
+fn upwind_padding_gives_the_same_window_as_padding_every_side() {
+    for wind in [0.0, 30.0, 90.0, 123.0, 180.0, 225.0, 270.0, 315.0] {
+        let f = orographic(Arc::new(Bumps), wind);
+        let core = f.layout.rect(WindowIndex { iy: -3, ix: 5 });
+        let full = f.solve_over(core.pad(f.margin), core);
+        assert_eq!(f.solve_over(upwind_pad(core, f.margin, wind), core), full, "wind from {wind}°");
+        assert!(full.data.iter().all(|v| v.is_finite() && *v >= 0.0));
+    }
+}
+
+#[test]
+fn precipitation_is_a_function_of_the_region_only() {
+    let region = Rect::new(-40, 70, 48, 56);
+    let whole = {
+        let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 });
+        Windowed::new(&engine, orographic(Arc::new(Bumps), 250.0)).query(region)
+    };
+    let engine = Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 });
+    let tensor = Windowed::new(&engine, orographic(Arc::new(Bumps), 250.0));
+    for part in [Rect::new(-10, 100, 9, 20), Rect::new(-40, 70, 13, 11), Rect::new(0, 120, 8, 6)] {
+        assert_eq!(tensor.query(part), whole.crop(part));
     }
 }

@@ -35,7 +35,12 @@ pub struct LayoutSettings {
 
 impl Default for LayoutSettings {
     fn default() -> Self {
-        LayoutSettings { ocean_fraction: 0.55, continent_scale_km: 2000.0, mountain_frequency: 1.0, climate_zone_scale_km: 3000.0 }
+        LayoutSettings {
+            ocean_fraction: 0.55,
+            continent_scale_km: 2000.0,
+            mountain_frequency: 1.0,
+            climate_zone_scale_km: 3000.0,
+        }
     }
 }
 

@@ -24,17 +24,20 @@ const CONTINENT_SHORTEST_M: f64 = 5_000.0;
 const DETAIL_LONGEST_M: f64 = 16_000.0;
 const DETAIL_SHORTEST_M: f64 = 1_000.0;
 /// Domain-warp displacement as a fraction of the continent scale.
-const WARP_FRACTION: f64 = 0.35;
+const WARP_FRACTION: f64 = 0.25;
 /// Height of a mountain crest over its surroundings, in standard deviations of the
 /// continental value (ranks are what matter, so only ratios between components count).
-const MOUNTAIN_AMPLITUDE: f64 = 1.2;
+const MOUNTAIN_AMPLITUDE: f64 = 3.0;
+/// Factor on the continental value's rise above the coast: continental interiors are mostly
+/// plains and shields, so the high ranks go to the mountain belts.
+const INTERIOR_RISE: f64 = 0.4;
 /// Detail amplitude on plains and extra in mountains, in the same units.
 const DETAIL_PLAIN: f64 = 0.04;
 const DETAIL_MOUNTAIN: f64 = 0.25;
 /// Width of the belt mask's soft edge, in belt-value units.
 const BELT_EDGE: f64 = 0.12;
 /// Side of the calibration sample's jittered lattice, and its spacing in continent scales.
-const SAMPLE_SIDE: i64 = 96;
+const SAMPLE_SIDE: i64 = 80;
 const SAMPLE_SPACING: f64 = 0.5;
 
 /// The noise components before calibration.
@@ -88,7 +91,8 @@ impl Noises {
     fn base(&self, y: f64, x: f64) -> Base {
         let (wy, wx) = self.warp(y, x);
         let low = self.low.at(wy, wx);
-        let full = low + self.high.at(wy, wx);
+        // The high octaves are not warped: warping stretches short wavelengths into streaks.
+        let full = low + self.high.at(y, x);
         let belt = 1.0 - self.belts.at(wy, wx).abs();
         Base { wy, wx, low, full, belt }
     }
@@ -141,7 +145,7 @@ pub(crate) struct Relief {
 
 impl Relief {
     /// Builds the noises, then calibrates thresholds and the rank map on a deterministic
-    /// jittered lattice spanning ~48 continent scales per side.
+    /// jittered lattice spanning 40 continent scales per side.
     pub(crate) fn new(seed: u64, s: &LayoutSettings) -> Relief {
         let noises = Noises::new(seed, s);
         let spacing = SAMPLE_SPACING * s.continent_scale_km * 1000.0;
@@ -179,9 +183,11 @@ impl Relief {
     /// The raw scalar: continental value + ranges + detail (larger in mountains).
     fn raw(&self, b: &Base, y: f64, x: f64) -> f64 {
         let m = self.mountain_weight(b);
-        let ranges = if m > 0.0 { m * (0.3 + 0.7 * self.noises.ridges.ridged(b.wy, b.wx)) } else { 0.0 };
+        let ranges = if m > 0.0 { m * (0.15 + 0.85 * self.noises.ridges.ridged(b.wy, b.wx)) } else { 0.0 };
         let detail = (DETAIL_PLAIN + DETAIL_MOUNTAIN * m) * self.noises.detail.at(y, x);
-        b.full + self.cal.sigma * (MOUNTAIN_AMPLITUDE * ranges + detail)
+        let coast = self.cal.coast;
+        let continental = if b.full > coast { coast + INTERIOR_RISE * (b.full - coast) } else { b.full };
+        continental + self.cal.sigma * (MOUNTAIN_AMPLITUDE * ranges + detail)
     }
 
     /// Elevation in metres at a point in metres.

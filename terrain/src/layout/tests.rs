@@ -44,6 +44,7 @@ fn land_fraction_follows_ocean_fraction() {
         let points: Vec<_> = lattice(150, 250_000.0).collect();
         let land = points.iter().filter(|&&(y, x)| l.elevation_at(y, x) > 0.0).count();
         let f = land as f64 / points.len() as f64;
+        println!("ocean fraction {p}: land fraction {f:.4}");
         assert!((f - (1.0 - p)).abs() < 0.05, "ocean fraction {p}: land fraction {f}");
     }
 }
@@ -56,6 +57,8 @@ fn elevations_follow_earth_like_hypsometry() {
     let land = sorted(all.iter().copied().filter(|&e| e > 0.0).collect());
     let sea = sorted(all.iter().copied().filter(|&e| e < 0.0).collect());
     let median = percentile(&land, 0.5);
+    let show = |v: &[f32]| [0.1, 0.5, 0.9, 0.99].map(|u| percentile(v, u));
+    println!("land percentiles 10/50/90/99: {:?} m, sea: {:?} m", show(&land), show(&sea));
     assert!((150.0..900.0).contains(&median), "land median {median} m");
     assert!(percentile(&land, 0.99) > 2500.0, "land 99th percentile {} m", percentile(&land, 0.99));
     let sea_median = percentile(&sea, 0.5);
@@ -70,6 +73,7 @@ fn mountain_frequency_raises_the_highest_land() {
         percentile(&land, 0.99)
     };
     let (flat, steep) = (p99(0.0), p99(2.0));
+    println!("99th percentile of land: {flat} m at frequency 0, {} m at 1, {steep} m at 2", p99(1.0));
     assert!(flat + 1000.0 < steep, "99th percentile of land: {flat} m without ranges, {steep} m at 2.0");
 }
 
@@ -124,7 +128,8 @@ fn climate_sketch_follows_the_zones() {
         }
         sum / 200.0
     };
-    let (equator, pole, next_equator) = (mean_temperature(0.0), mean_temperature(zone_m), mean_temperature(2.0 * zone_m));
+    let (equator, pole, next_equator) =
+        (mean_temperature(0.0), mean_temperature(zone_m), mean_temperature(2.0 * zone_m));
     assert!(equator > pole + 25.0 && next_equator > pole + 25.0, "{equator} {pole} {next_equator}");
 }
 
@@ -164,7 +169,9 @@ fn render() {
         println!("{}", path.display());
     }
     let s = l.climate_sketch(16_000.0).query(Rect::new(-(n as i64) / 2, -(n as i64) / 2, n as i64, n as i64));
-    for (c, name, lo, hi) in [(0, "temperature", -25.0, 30.0), (2, "precipitation", 0.0, 2300.0), (3, "continentality", 0.0, 1.0)] {
+    for (c, name, lo, hi) in
+        [(0, "temperature", -25.0, 30.0), (2, "precipitation", 0.0, 2300.0), (3, "continentality", 0.0, 1.0)]
+    {
         let rgb: Vec<u8> = s
             .channel(c)
             .iter()

@@ -74,7 +74,8 @@ impl Pipeline {
                 settings: settings.climate.clone(),
                 pixel_metres: coarse_metres,
                 layout: WindowLayout::square(32, 16, 0),
-                margin: 16,
+                // Rain shadows fade over ~500 km of land: keep ~400 km of upwind history.
+                margin: 48,
             },
         );
         let elevation: Arc<dyn Source> = Arc::new(layout.elevation(MODEL_PIXEL_METRES));
@@ -157,3 +158,6 @@ impl Pipeline {
         self.coarse_elevation.query(Rect::new(cy, cx, 1, 1)).data[0]
     }
 }
+
+#[cfg(test)]
+mod tests;
