@@ -6,9 +6,13 @@
 //! `infiniterra-terrain` crate, which knows nothing of Minecraft.
 
 pub mod bench;
+pub mod biome;
 pub mod cli;
 pub mod config;
+pub mod eval;
 pub mod export;
+pub mod fill;
 pub mod render;
+pub mod server;
 
 pub use infiniterra_terrain as terrain;

@@ -54,6 +54,15 @@ pub struct ExportArgs {
     pub out: PathBuf,
 }
 
+/// Exit code 2 when the user's input is at fault, 1 otherwise.
+fn classify<E: std::error::Error + Send + Sync + 'static>(bad_input: bool, e: E) -> Failure {
+    if bad_input {
+        Failure::input(e)
+    } else {
+        Failure::runtime(e)
+    }
+}
+
 fn pipeline(config: &Config) -> Pipeline {
     Pipeline::new(config.world.seed, &config.terrain())
 }
@@ -66,9 +75,9 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
     let req = RenderRequest { x0: a.x0, z0: a.z0, width: a.size.width, height: a.size.height, zoom: a.zoom, layer: a.layer };
     let pipeline = pipeline(config);
     let mut progress = Progress::new("render", "rows");
-    let image = render::render(&pipeline, &req, &mut |d, t| progress.update(d, t)).map_err(Failure::input)?;
+    let image = render::render(&pipeline, &req, &mut |d, t| progress.update(d, t)).map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
-    image.save(&a.out).map_err(|e| Failure::runtime(anyhow::anyhow!("writing {}: {e}", a.out.display())))?;
+    render::save_png(&image, &a.out).map_err(Failure::runtime)?;
     println!("wrote {} ({}×{} px)", a.out.display(), image.width(), image.height());
     Ok(())
 }
@@ -80,7 +89,7 @@ pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
     let pipeline = pipeline(config);
     let mut progress = Progress::new("export", "rows");
     let summary =
-        export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t)).map_err(Failure::runtime)?;
+        export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t)).map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
     println!(
         "wrote {} ({}×{}, {:.1}..{:.1} m) and {}",

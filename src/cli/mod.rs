@@ -34,22 +34,19 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Run the Minecraft server (Java Edition 1.20.1).
-    Serve,
+    Serve {
+        /// Folder of biome rule files (`*.toml`); the console's `reload` re-reads it.
+        #[arg(long, default_value = "biomes")]
+        biomes: PathBuf,
+    },
     /// Draw a map of any rectangle of the world as a PNG.
     Render(maps::RenderArgs),
     /// Write raw elevation (float32 metres, .npy) of a rectangle, with a JSON sidecar.
     Export(maps::ExportArgs),
     /// Fetch or prepare the real elevation data the models learn from.
-    Data {
-        /// `fetch` or `prepare`.
-        action: String,
-    },
+    Data(crate::eval::DataArgs),
     /// Measure how realistic generated terrain is against real terrain.
-    Eval {
-        /// Any further arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        rest: Vec<String>,
-    },
+    Eval(crate::eval::EvalArgs),
     /// Train a stage of the model hierarchy.
     Train {
         /// Any further arguments.
@@ -111,14 +108,29 @@ pub fn load_config(cli: &Cli) -> Result<Config, Failure> {
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Failure> {
     match &cli.command {
-        Command::Serve => not_yet("serve", 5, "the Minecraft server"),
+        Command::Serve { biomes } => {
+            let options = crate::server::ServeOptions { biomes_dir: biomes.clone() };
+            crate::server::serve(&load_config(&cli)?, &options).map_err(|e| match e {
+                crate::server::ServeError::Input(e) => Failure::input(e),
+                crate::server::ServeError::Runtime(e) => Failure::runtime(e),
+            })
+        }
         Command::Render(a) => maps::render(&load_config(&cli)?, a),
         Command::Export(a) => maps::export(&load_config(&cli)?, a),
-        Command::Data { action } => match action.as_str() {
-            "fetch" | "prepare" => not_yet(&format!("data {action}"), 3, "real elevation data"),
-            other => Err(Failure::input(anyhow::anyhow!("unknown data action {other:?}: use `fetch` or `prepare`"))),
-        },
-        Command::Eval { .. } => not_yet("eval", 3, "the realism report"),
+        Command::Data(a) => crate::eval::data::run(a).map_err(Failure::runtime),
+        Command::Eval(a) => {
+            let mut progress = progress::Progress::new("eval", "tiles");
+            let report = crate::eval::run(a, &mut |d, t| progress.update(d, t));
+            progress.finish();
+            match report {
+                Ok(report) => {
+                    println!("{report}\nwrote {}", a.out.display());
+                    Ok(())
+                }
+                Err(e @ crate::eval::EvalError::Input(_)) => Err(Failure::input(e)),
+                Err(e) => Err(Failure::runtime(e)),
+            }
+        }
         Command::Train { .. } => not_yet("train", 4, "learned terrain"),
         Command::Pregen { .. } => not_yet("pregen", 6, "pre-generation and Anvil persistence"),
         Command::Bench(a) => crate::bench::run(&load_config(&cli)?, a).map_err(Failure::runtime),

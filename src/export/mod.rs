@@ -107,6 +107,20 @@ pub enum ExportError {
     },
 }
 
+impl ExportError {
+    /// True when the request itself is wrong (exit code 2, "bad usage or bad input"), false
+    /// when a file could not be read or written (exit code 1).
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            ExportError::BadSize { .. }
+                | ExportError::OutOfRange { .. }
+                | ExportError::BadVertical(_)
+                | ExportError::OutputIsJson(_)
+        )
+    }
+}
+
 /// Exports the elevation of `req`'s region to `out` (`.npy`, float32 metres) and its
 /// sidecar `out` with `.json`. `progress(done, total)` counts array rows.
 pub fn export(
@@ -124,9 +138,10 @@ pub fn export(
     if json == out {
         return Err(ExportError::OutputIsJson(out.to_path_buf()));
     }
+    // Elevation only: the climate channels would cost more than the terrain itself.
     let mut query = |r: Rect| match req.grid {
-        Grid::Block => pipeline.columns(r),
-        Grid::Model => pipeline.model(r),
+        Grid::Block => pipeline.elevation_columns(r),
+        Grid::Model => pipeline.elevation(r),
     };
     let (min, max) = write_array(out, rect, &mut query, progress)?;
 

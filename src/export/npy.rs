@@ -163,8 +163,7 @@ pub fn read_npy_f32(path: &Path) -> Result<((usize, usize), Vec<f32>), NpyError>
     if bytes.len() < data_start {
         return Err(format(format!("the header claims {header_len} bytes but the file ends first")));
     }
-    let header = std::str::from_utf8(&bytes[start..data_start])
-        .map_err(|_| format("the header is not text".into()))?;
+    let header = std::str::from_utf8(&bytes[start..data_start]).map_err(|_| format("the header is not text".into()))?;
     let header = parse_header(header).map_err(format)?;
 
     if header.fortran_order {
@@ -172,11 +171,16 @@ pub fn read_npy_f32(path: &Path) -> Result<((usize, usize), Vec<f32>), NpyError>
     }
     let shape = match header.shape[..] {
         [h, w] => (h, w),
-        _ => return Err(unsupported(format!("{}-D shape {:?}; a 2-D array is needed", header.shape.len(), header.shape))),
+        _ => {
+            return Err(unsupported(format!(
+                "{}-D shape {:?}; a 2-D array is needed",
+                header.shape.len(),
+                header.shape
+            )))
+        }
     };
-    let dtype = Dtype::parse(&header.descr).ok_or_else(|| {
-        unsupported(format!("dtype '{}' (readable: '<f4', '<f8', '<i2', '<i4')", header.descr))
-    })?;
+    let dtype = Dtype::parse(&header.descr)
+        .ok_or_else(|| unsupported(format!("dtype '{}' (readable: '<f4', '<f8', '<i2', '<i4')", header.descr)))?;
     let count = shape.0.checked_mul(shape.1).ok_or_else(|| format(format!("shape {shape:?} is too large")))?;
     let expected = count.checked_mul(dtype.size()).ok_or_else(|| format(format!("shape {shape:?} is too large")))?;
     let data = &bytes[data_start..];
@@ -369,9 +373,9 @@ mod tests {
         assert!(read_error(&raw_npy("<f4", "(4,)", &[0u8; 16])).contains("2-D"));
         assert!(read_error(&raw_npy(">f4", "(2, 2)", &[0u8; 16])).contains(">f4"));
         assert!(read_error(&raw_npy("<c8", "(2, 2)", &[0u8; 32])).contains("<c8"));
-        let fortran = String::from_utf8(raw_npy("<f4", "(2, 2)", &[])).unwrap().replace("False", "True ");
-        let mut fortran = fortran.into_bytes();
-        fortran.extend_from_slice(&[0u8; 16]);
+        let mut fortran = raw_npy("<f4", "(2, 2)", &[0u8; 16]);
+        let at = fortran.windows(5).position(|w| w == b"False").unwrap();
+        fortran[at..at + 5].copy_from_slice(b"True ");
         assert!(read_error(&fortran).contains("Fortran"));
     }
 

@@ -58,6 +58,7 @@ fn json_output_name_is_refused_before_any_work() {
     let p = Pipeline::new(1, &TerrainSettings::default());
     let err = export(&p, &request(Grid::Block), &VERTICAL, Path::new("x.json"), &mut |_, _| {}).unwrap_err();
     assert!(matches!(err, ExportError::OutputIsJson(_)), "{err}");
+    assert!(err.is_bad_input());
     let bad = Vertical { metres_per_block: 0.0, ..VERTICAL };
     let err = export(&p, &request(Grid::Block), &bad, Path::new("x.npy"), &mut |_, _| {}).unwrap_err();
     assert!(err.to_string().contains("metres_per_block"), "{err}");

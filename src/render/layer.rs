@@ -27,8 +27,14 @@ pub enum Layer {
 
 impl Layer {
     /// Every layer, in the order the help text lists them.
-    pub const ALL: [Layer; 6] =
-        [Layer::Elevation, Layer::Temperature, Layer::Precipitation, Layer::Seasonality, Layer::Variability, Layer::Biome];
+    pub const ALL: [Layer; 6] = [
+        Layer::Elevation,
+        Layer::Temperature,
+        Layer::Precipitation,
+        Layer::Seasonality,
+        Layer::Variability,
+        Layer::Biome,
+    ];
 
     /// The name used on the command line and in titles.
     pub fn name(self) -> &'static str {
@@ -106,7 +112,13 @@ fn fraction(range: (f32, f32), v: f32) -> f32 {
 /// The style of a layer, or `None` for the biome layer (not drawable yet).
 pub(crate) fn style(layer: Layer) -> Option<Style> {
     use ramp::{SEASONALITY_RANGE as S, TEMPERATURE_RANGE as T, VARIABILITY_RANGE as V};
-    let climate = |channel: usize, legend: Legend| Style { channel, legend, land_shading: 0.35, sea_shading: 0.1, coastline: true };
+    let climate = |channel: usize, legend: Legend| Style {
+        channel,
+        legend,
+        land_shading: 0.35,
+        sea_shading: 0.1,
+        coastline: true,
+    };
     Some(match layer {
         Layer::Elevation => Style {
             channel: channel::ELEVATION,
@@ -158,7 +170,7 @@ pub(crate) fn style(layer: Layer) -> Option<Style> {
                 value_at: |t| linear(V, t),
                 position_of: |v| fraction(V, v),
                 colour: |v| ramp::viridis(v, V.0, V.1),
-                ticks: &[0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0],
+                ticks: &[0.0, 20.0, 40.0, 60.0, 80.0],
             },
         ),
         Layer::Biome => return None,

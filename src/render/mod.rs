@@ -18,8 +18,8 @@ use image::{Rgb, RgbImage};
 
 pub use layer::{Layer, UnknownLayer};
 
-use crate::terrain::tile::div_ceil;
 use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
+use crate::terrain::tile::div_ceil;
 use crate::terrain::{Pipeline, Rect, Tile};
 use sample::{CellGrid, Geometry, Samples};
 
@@ -104,6 +104,14 @@ pub enum RenderError {
     },
 }
 
+impl RenderError {
+    /// True when the request itself is wrong (exit code 2, "bad usage or bad input"), false
+    /// when the map could not be written (exit code 1).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, RenderError::Write { .. })
+    }
+}
+
 /// Draws the map `req` asks for. `progress(done, total)` is called after each strip with
 /// image rows done and image rows in all.
 pub fn render(
@@ -117,10 +125,14 @@ pub fn render(
     // Below 4 blocks per pixel the map resolves single blocks, so it reads the upsampled
     // block grid the world is built from; from 4 up it reads model pixels directly, which is
     // exact at zoom 4 and avoids upsampling work that sampling would throw away.
-    let (grid, mut query): (CellGrid, Box<dyn FnMut(Rect) -> Tile>) = if req.zoom < BLOCKS_PER_MODEL_PIXEL {
-        (CellGrid { blocks_per_cell: 1, max_row_gap: i64::MAX }, Box::new(|r| pipeline.columns(r)))
-    } else {
-        (CellGrid { blocks_per_cell: BLOCKS_PER_MODEL_PIXEL, max_row_gap: 2 }, Box::new(|r| pipeline.model(r)))
+    // An elevation map needs no climate (channel 0 is elevation either way), which makes
+    // maps of huge areas far cheaper.
+    let elevation_only = req.layer == Layer::Elevation;
+    let (grid, mut query): (CellGrid, Box<dyn FnMut(Rect) -> Tile>) = match (req.zoom < BLOCKS_PER_MODEL_PIXEL, elevation_only) {
+        (true, true) => (CellGrid::BLOCKS, Box::new(|r| pipeline.elevation_columns(r))),
+        (true, false) => (CellGrid::BLOCKS, Box::new(|r| pipeline.columns(r))),
+        (false, true) => (CellGrid::MODEL, Box::new(|r| pipeline.elevation(r))),
+        (false, false) => (CellGrid::MODEL, Box::new(|r| pipeline.model(r))),
     };
     Ok(draw(req, size, &style, &title, grid, &mut *query, progress))
 }
@@ -171,22 +183,29 @@ fn check(req: &RenderRequest) -> Result<(u32, u32), RenderError> {
 }
 
 fn title_lines(req: &RenderRequest, seed: u64, stages: &[String]) -> Vec<String> {
-    let metres_per_px = req.zoom as f64 * block_metres();
+    let stages = if stages.is_empty() { "none".to_string() } else { stages.join(", ") };
     vec![
-        format!("{} - seed {}", req.layer, seed),
+        format!("{} - seed {} - stages: {}", req.layer, seed, stages),
         format!(
-            "x {}..{}, z {}..{}: {}×{} blocks, zoom {} blocks/px ({} m/px)",
+            "x {}..{}, z {}..{} ({}×{} blocks)",
             req.x0,
-            req.x0 + req.width,
+            req.x0.saturating_add(req.width),
             req.z0,
-            req.z0 + req.height,
+            req.z0.saturating_add(req.height),
             req.width,
-            req.height,
-            req.zoom,
-            metres_per_px
+            req.height
         ),
-        format!("stages: {}", if stages.is_empty() { "none".to_string() } else { stages.join(", ") }),
+        format!("zoom {} blocks/px = {}/px", req.zoom, distance(req.zoom as f64 * block_metres())),
     ]
+}
+
+/// A horizontal distance for people: metres below a kilometre, kilometres above.
+fn distance(metres: f64) -> String {
+    if metres < 1000.0 {
+        format!("{} m", (metres * 10.0).round() / 10.0)
+    } else {
+        format!("{} km", (metres / 100.0).round() / 10.0)
+    }
 }
 
 /// Image rows per strip: enough that the ring rows re-fetched per strip cost little, few

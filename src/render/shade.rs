@@ -9,10 +9,10 @@
 const SUN_ALTITUDE: f32 = std::f32::consts::FRAC_PI_4;
 
 /// Vertical exaggeration for pixels `metres_per_px` wide: 2× at block resolution (125 m),
-/// growing with the square root of the pixel size, which keeps mountain ranges legible on
-/// continental maps without turning block-scale maps into noise.
+/// growing with the 0.4th power of the pixel size (~18× at 32 km/px), which keeps mountain
+/// ranges legible on continental maps without turning them into black-and-white streaks.
 pub(crate) fn exaggeration(metres_per_px: f64) -> f32 {
-    (2.0 * (metres_per_px / 125.0).sqrt()).clamp(1.0, 60.0) as f32
+    (2.0 * (metres_per_px / 125.0).powf(0.4)).clamp(1.0, 40.0) as f32
 }
 
 /// Illumination of a pixel from its four neighbours' elevations (metres), `spacing_m` apart:

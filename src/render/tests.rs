@@ -33,14 +33,20 @@ fn draw_synthetic(req: &RenderRequest) -> (RgbImage, Vec<(u64, u64)>) {
     let style = layer::style(req.layer).unwrap();
     let size = check(req).unwrap();
     let title = title_lines(req, 7, &["layout".to_string()]);
-    let grid = if req.zoom < 4 {
-        CellGrid { blocks_per_cell: 1, max_row_gap: i64::MAX }
-    } else {
-        CellGrid { blocks_per_cell: 4, max_row_gap: 2 }
-    };
+    let grid = if req.zoom < 4 { CellGrid::BLOCKS } else { CellGrid::MODEL };
     let mut calls = Vec::new();
     let img = draw(req, size, &style, &title, grid, &mut field, &mut |d, t| calls.push((d, t)));
     (img, calls)
+}
+
+/// Clearly blue (the sea ramp).
+fn is_sea(c: &[u8; 3]) -> bool {
+    c[2] as i32 > c[0] as i32 + 40
+}
+
+/// Clearly green, yellow or brown (the land ramp), not blue.
+fn is_land(c: &[u8; 3]) -> bool {
+    c[1] as i32 > c[2] as i32 + 20 || c[0] as i32 > c[2] as i32 + 20
 }
 
 fn distinct_map_colours(img: &RgbImage, w: u32, h: u32) -> HashSet<[u8; 3]> {
@@ -68,8 +74,8 @@ fn image_is_the_map_plus_a_panel_below() {
 fn elevation_map_shows_sea_and_land() {
     let (img, _) = draw_synthetic(&request(Layer::Elevation));
     let colours = distinct_map_colours(&img, 64, 64);
-    assert!(colours.iter().any(|c| c[2] > c[0] + 40), "some sea");
-    assert!(colours.iter().any(|c| c[1] > c[2] + 20), "some land");
+    assert!(colours.iter().any(is_sea), "some sea");
+    assert!(colours.iter().any(is_land), "some land");
 }
 
 #[test]
@@ -108,7 +114,7 @@ fn bad_requests_are_refused_with_reasons() {
     assert!(far.contains("range"), "{far}");
 }
 
-/// The pipeline is shared by the end-to-end tests: building it is the slow part.
+/// The real pipeline at default settings, for the end-to-end checks.
 fn pipeline() -> Pipeline {
     Pipeline::new(42, &TerrainSettings::default())
 }
@@ -123,7 +129,9 @@ fn biome_layer_needs_rules() {
 #[test]
 fn pipeline_render_is_deterministic_and_not_uniform() {
     let p = pipeline();
-    for req in [request(Layer::Elevation), RenderRequest { zoom: 64, width: 8192, height: 4096, ..request(Layer::Elevation) }] {
+    for req in
+        [request(Layer::Elevation), RenderRequest { zoom: 64, width: 8192, height: 4096, ..request(Layer::Elevation) }]
+    {
         let a = render(&p, &req, &mut |_, _| {}).unwrap();
         let b = render(&pipeline(), &req, &mut |_, _| {}).unwrap();
         assert!(a == b, "two renders of the same request differ");
@@ -138,8 +146,8 @@ fn continental_map_has_sea_and_land() {
     let req = RenderRequest { x0: -8192, z0: -8192, width: 16384, height: 16384, zoom: 64, layer: Layer::Elevation };
     let img = render(&pipeline(), &req, &mut |_, _| {}).unwrap();
     let colours = distinct_map_colours(&img, 256, 256);
-    assert!(colours.iter().any(|c| c[2] > c[0] + 40), "no sea in a 2000 km map");
-    assert!(colours.iter().any(|c| c[1] > c[2] + 20 || c[0] > c[2] + 20), "no land in a 2000 km map");
+    assert!(colours.iter().any(is_sea), "no sea in a 2000 km map");
+    assert!(colours.iter().any(is_land), "no land in a 2000 km map");
 }
 
 #[test]
@@ -153,4 +161,15 @@ fn save_png_writes_a_readable_file() {
     assert!(!dir.path().join("map.png.tmp").exists());
     let err = save_png(&img, &dir.path().join("missing/map.png")).unwrap_err();
     assert!(err.to_string().contains("missing"), "{err}");
+}
+
+#[test]
+fn title_says_what_where_and_how_big() {
+    let lines = title_lines(&RenderRequest { zoom: 256, ..request(Layer::Precipitation) }, 42, &["layout".into()]);
+    assert_eq!(lines.len(), panel::TITLE_LINES);
+    assert_eq!(lines[0], "precipitation - seed 42 - stages: layout");
+    assert_eq!(lines[1], "x -64..64, z 32..160 (128×128 blocks)");
+    assert_eq!(lines[2], "zoom 256 blocks/px = 32 km/px");
+    assert_eq!(distance(125.0), "125 m");
+    assert_eq!(distance(1500.0), "1.5 km");
 }

@@ -8,6 +8,7 @@ pub mod climate;
 pub mod encoding;
 pub mod infinite;
 pub mod layout;
+pub mod metrics;
 pub mod noise;
 pub mod pipeline;
 pub mod settings;

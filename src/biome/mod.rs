@@ -1,0 +1,130 @@
+//! Biome rules: which Minecraft biome a 4×4×4 cell gets, from its climate and terrain in
+//! physical units, as written by the server owner in `biomes/*.toml`.
+//!
+//! Owns: the rule file format (documented at the top of `biomes/default.toml`), its
+//! validation and error messages, the compiled first-match table and the list of 1.20.1
+//! overworld biomes. Must not touch: the terrain pipeline (it receives numbers, not tiles),
+//! the server's reload command (it only offers a load that either fully succeeds or changes
+//! nothing), Minecraft registries beyond names.
+//!
+//! Semantics in one paragraph: files are read in file-name order and their rules
+//! concatenated; a rule is a box of half-open ranges `[min, max)`, one per quantity it names;
+//! the first rule whose box holds the conditions gives the biome, and the configured
+//! `fallback` is used where none does, so a lookup never fails. At load, a rule that an
+//! earlier rule entirely covers is an error (it could never apply), and so is an overlap
+//! between rules of different biomes unless the earlier rule says `override = true`.
+
+mod error;
+mod load;
+mod names;
+mod rules;
+
+#[cfg(test)]
+mod default_tests;
+#[cfg(test)]
+mod tests;
+
+use std::path::{Path, PathBuf};
+
+pub use error::{BiomeError, Location, Problem};
+pub use names::OVERWORLD_BIOMES;
+
+/// What a rule sees for one 4×4×4 biome cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conditions {
+    /// Annual mean air temperature at the cell's altitude, °C (the caller applies the lapse
+    /// rate for cells above the surface).
+    pub temperature_c: f32,
+    /// Temperature seasonality: standard deviation of the monthly means, °C.
+    pub seasonality_c: f32,
+    /// Annual precipitation, mm.
+    pub precipitation_mm: f32,
+    /// Inter-annual precipitation variability (coefficient of variation), %.
+    pub variability_pct: f32,
+    /// The cell's altitude, metres above sea level (negative under water); for cells at or
+    /// below the surface, the surface elevation.
+    pub elevation_m: f32,
+    /// The column's ground or sea-floor elevation, metres; below 0 the column is sea.
+    pub surface_m: f32,
+    /// Surface slope, degrees (0 flat .. 90).
+    pub slope_deg: f32,
+}
+
+/// A validated, compiled set of biome rules.
+///
+/// Cheap to share: `Clone + Send + Sync`, immutable once loaded. To reload, load a new value
+/// and swap it in; a failed load returns an error and leaves nothing half-applied.
+#[derive(Clone, Debug)]
+pub struct BiomeRules {
+    table: rules::Table,
+    /// Names of the rules, parallel to the table (for [`BiomeRules::matching_rule`]).
+    names: Vec<String>,
+}
+
+impl BiomeRules {
+    /// Loads every `*.toml` file of `dir`, in file-name order.
+    ///
+    /// Either every file reads and validates and a fresh value is returned, or the first
+    /// problem (in file order) is returned and nothing else happens: a server reloading its
+    /// rules keeps the old value on error.
+    pub fn load_dir(dir: &Path) -> Result<BiomeRules, BiomeError> {
+        let read_error = |source| BiomeError::Read { path: dir.to_path_buf(), source };
+        let mut paths = Vec::new();
+        for entry in std::fs::read_dir(dir).map_err(read_error)? {
+            let path = entry.map_err(read_error)?.path();
+            if path.extension().is_some_and(|e| e == "toml") && path.is_file() {
+                paths.push(path);
+            }
+        }
+        if paths.is_empty() {
+            return Err(BiomeError::NoFiles { dir: dir.to_path_buf() });
+        }
+        paths.sort_by(|a, b| a.file_name().cmp(&b.file_name()));
+        let mut files = Vec::with_capacity(paths.len());
+        for path in paths {
+            let text =
+                std::fs::read_to_string(&path).map_err(|source| BiomeError::Read { path: path.clone(), source })?;
+            files.push((path, text));
+        }
+        BiomeRules::from_sources(&files)
+    }
+
+    /// Builds rules from `(name, contents)` pairs, in the order given (tests, embedded rules).
+    pub fn from_sources(files: &[(PathBuf, String)]) -> Result<BiomeRules, BiomeError> {
+        let loaded = load::load(files)?;
+        Ok(BiomeRules { table: loaded.table, names: loaded.rules.into_iter().map(|r| r.name).collect() })
+    }
+
+    /// The biome for `c`, e.g. `"minecraft:plains"`: the first matching rule's, else the
+    /// fallback. Never fails (a NaN in any quantity matches no rule: the fallback) and does
+    /// not allocate: it runs for every biome cell of every chunk.
+    #[inline]
+    pub fn biome(&self, c: &Conditions) -> &str {
+        self.table.biome(c)
+    }
+
+    /// The name of the rule that decides `c`, or `None` where the fallback does (for
+    /// debugging a map or answering "why is this a desert?").
+    pub fn matching_rule(&self, c: &Conditions) -> Option<&str> {
+        self.table.first_match(c).map(|i| self.names[i].as_str())
+    }
+
+    /// Every biome the rules can produce, the fallback included: sorted, without repeats
+    /// (for palettes and registries).
+    pub fn biome_names(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = self.table.biomes.iter().copied().chain([self.table.fallback]).collect();
+        names.sort_unstable();
+        names.dedup();
+        names
+    }
+
+    /// The biome used where no rule matches.
+    pub fn fallback(&self) -> &str {
+        self.table.fallback
+    }
+
+    /// How many rules were loaded, over all files.
+    pub fn rule_count(&self) -> usize {
+        self.table.bounds.len()
+    }
+}

@@ -1,0 +1,151 @@
+//! Loading what `eval` compares: a generated heightmap (`.npy` + JSON sidecar) and a
+//! reference (a prepared set directory, or one `.npy` + sidecar), cut into tiles of the
+//! reference's size at the reference's resolution.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::EvalError;
+use crate::export::{read_npy_f32, ExportMeta, Grid};
+use crate::terrain::metrics::Raster;
+use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
+
+/// Tile side when neither file says (the prepared sets' size).
+pub const DEFAULT_TILE: usize = 256;
+
+/// The sidecar fields `eval` reads: export sidecars and prepared-set sidecars both have
+/// `metres_per_pixel`; a stack of tiles says `tile`; an export says where it lies.
+#[derive(Debug, Deserialize)]
+struct Sidecar {
+    metres_per_pixel: f64,
+    #[serde(default)]
+    tile: Option<usize>,
+    #[serde(default)]
+    x0: Option<i64>,
+    #[serde(default)]
+    z0: Option<i64>,
+    #[serde(default)]
+    grid: Option<Grid>,
+}
+
+/// One heightmap file and what its sidecar says about it.
+#[derive(Debug)]
+pub struct Heightmap {
+    /// The array file.
+    pub path: PathBuf,
+    /// The whole array as one raster (a stack of tiles is N tiles stacked along rows).
+    pub raster: Raster,
+    /// Side of the stacked tiles, when the file is a stack.
+    pub tile: Option<usize>,
+    /// Global pixel coordinates (x, y) of the first pixel on this file's own grid, when known.
+    pub origin: Option<(i64, i64)>,
+    /// Array pixels per model pixel along each axis (1 on the model grid, 4 on the block grid).
+    pub pixels_per_model_pixel: f64,
+}
+
+impl Heightmap {
+    /// Reads `path` and its sidecar `path.json`.
+    pub fn load(path: &Path) -> Result<Heightmap, EvalError> {
+        let ((rows, cols), data) = read_npy_f32(path).map_err(|e| EvalError::Input(e.to_string()))?;
+        let json = ExportMeta::path_for(path);
+        let text = std::fs::read_to_string(&json).map_err(|e| {
+            EvalError::Input(format!(
+                "cannot read {} (the sidecar saying the resolution of {}): {e}",
+                json.display(),
+                path.display()
+            ))
+        })?;
+        let side: Sidecar = serde_json::from_str(&text)
+            .map_err(|e| EvalError::Input(format!("{} is not valid sidecar JSON: {e}", json.display())))?;
+        if !(side.metres_per_pixel.is_finite() && side.metres_per_pixel > 0.0) {
+            return Err(EvalError::Input(format!(
+                "{}: metres_per_pixel must be positive (got {})",
+                json.display(),
+                side.metres_per_pixel
+            )));
+        }
+        if let Some(t) = side.tile {
+            if t == 0 || t != cols || rows % t != 0 {
+                return Err(EvalError::Input(format!(
+                    "{}: a stack of {t}×{t} tiles needs {t} columns and a multiple of {t} rows, the array is {rows}×{cols}",
+                    path.display()
+                )));
+            }
+        }
+        if rows < 3 || cols < 3 {
+            return Err(EvalError::Input(format!("{} is {rows}×{cols}: too small to measure", path.display())));
+        }
+        let blocks_per_cell = side.grid.map_or(BLOCKS_PER_MODEL_PIXEL, Grid::blocks_per_cell);
+        let origin = side.x0.zip(side.z0).map(|(x, z)| (x.div_euclid(blocks_per_cell), z.div_euclid(blocks_per_cell)));
+        Ok(Heightmap {
+            path: path.to_path_buf(),
+            raster: Raster::new(rows, cols, side.metres_per_pixel, data),
+            tile: side.tile,
+            origin,
+            // From the resolution, so a prepared stack (no grid) is handled like an export.
+            pixels_per_model_pixel: MODEL_PIXEL_METRES / side.metres_per_pixel,
+        })
+    }
+
+    /// The separate pieces of the file: its tiles for a stack, else the whole map.
+    pub fn pieces(&self) -> Vec<Raster> {
+        match self.tile {
+            Some(t) => self.raster.tiles(t),
+            None => vec![self.raster.clone()],
+        }
+    }
+
+    /// Tiles of `size` at `metres` per pixel: each piece is resampled (bilinear) when its
+    /// resolution differs, then cut into whole tiles.
+    pub fn tiles_at(&self, metres: f64, size: usize) -> Vec<Raster> {
+        self.pieces()
+            .into_iter()
+            .map(|p| if (p.metres - metres).abs() > 1e-6 * metres { p.resample(metres) } else { p })
+            .flat_map(|p| p.tiles(size))
+            .collect()
+    }
+}
+
+/// The reference: the held-out real region and, for a prepared set, its training region.
+#[derive(Debug)]
+pub struct Reference {
+    /// What was named on the command line.
+    pub path: PathBuf,
+    /// The held-out split (or the one file given).
+    pub heldout: Heightmap,
+    /// The training split of a prepared set (the real-vs-real baseline).
+    pub train: Option<Heightmap>,
+    /// Tile side the metrics use.
+    pub tile: usize,
+}
+
+impl Reference {
+    /// Reads a prepared set directory (`heldout.npy`, `train.npy` with their sidecars) or a
+    /// single `.npy` with its sidecar.
+    pub fn load(path: &Path) -> Result<Reference, EvalError> {
+        if path.is_dir() {
+            let heldout = Heightmap::load(&path.join("heldout.npy"))?;
+            let train = Heightmap::load(&path.join("train.npy"))?;
+            if (train.raster.metres - heldout.raster.metres).abs() > 1e-9 {
+                return Err(EvalError::Input(format!("{}: train and held-out resolutions differ", path.display())));
+            }
+            let tile = heldout.tile.unwrap_or(DEFAULT_TILE);
+            return Ok(Reference { path: path.to_path_buf(), heldout, train: Some(train), tile });
+        }
+        if !path.exists() {
+            return Err(EvalError::Input(format!(
+                "reference {} does not exist (run `infiniterra data prepare`, then name e.g. data/prepared/core)",
+                path.display()
+            )));
+        }
+        let heldout = Heightmap::load(path)?;
+        let tile = heldout.tile.unwrap_or(DEFAULT_TILE);
+        Ok(Reference { path: path.to_path_buf(), heldout, train: None, tile })
+    }
+
+    /// Reference resolution, metres per pixel.
+    pub fn metres(&self) -> f64 {
+        self.heldout.raster.metres
+    }
+}

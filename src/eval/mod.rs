@@ -1,0 +1,190 @@
+//! Real terrain: getting the reference data (`infiniterra data fetch | prepare`, which run
+//! the scripts in `scripts/data/`) and measuring generated terrain against it
+//! (`infiniterra eval`, DESIGN §3).
+//!
+//! Owns: loading heightmaps and prepared sets, the baselines (fBm matched in amplitude,
+//! real-vs-real), the realism table and the report image. The metric math lives in
+//! `infiniterra_terrain::metrics`. Must not touch: the pipeline (generated terrain comes in
+//! as an exported `.npy`), the command line's parsing beyond [`EvalArgs`] and [`DataArgs`].
+
+pub mod data;
+mod input;
+mod measure;
+mod plot;
+mod report;
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use image::Rgb;
+
+pub use data::DataArgs;
+pub use input::{Heightmap, Reference};
+pub use report::Report;
+
+use crate::terrain::metrics::{fbm, Raster, SeamLines, FBM_BETA};
+use crate::terrain::pipeline::MODEL_PIXEL_METRES;
+use report::Column;
+
+/// Seed of the fBm baseline: fixed, so every report compares against the same noise.
+pub const FBM_SEED: u64 = 0x1FB3_5EED;
+
+/// Arguments of `infiniterra eval`.
+#[derive(Debug, Args)]
+pub struct EvalArgs {
+    /// Generated heightmap: float32 `.npy` with its JSON sidecar (e.g. from
+    /// `infiniterra export --grid model`).
+    #[arg(long)]
+    pub generated: PathBuf,
+    /// Reference: a prepared set directory (e.g. `data/prepared/core`: held-out split is the
+    /// reference, training split the real-vs-real baseline) or one `.npy` with its sidecar.
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Report image (slope histograms and power spectra).
+    #[arg(long, default_value = "eval_report.png")]
+    pub out: PathBuf,
+    /// Window stride of the generator in model pixels: seams are measured on lines this far
+    /// apart (32 = the pipeline's window stride).
+    #[arg(long, default_value_t = 32)]
+    pub seam_stride: usize,
+}
+
+/// Why an evaluation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    /// A missing, unreadable or inconsistent input (exit status 2).
+    #[error("{0}")]
+    Input(String),
+    /// The report image could not be written (exit status 1).
+    #[error("cannot write {path}: {source}")]
+    Output {
+        /// The image.
+        path: PathBuf,
+        /// Why.
+        source: image::ImageError,
+    },
+}
+
+/// The fBm baseline: one tile per generated tile, same size, with that tile's mean and
+/// standard deviation (so amplitude matches tile by tile), β = [`FBM_BETA`].
+fn fbm_like(tiles: &[Raster]) -> Vec<Raster> {
+    tiles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let (mean, std) = t.mean_std();
+            let mut f = fbm(t.rows, t.cols, t.metres, FBM_BETA, FBM_SEED + i as u64);
+            f.data.iter_mut().for_each(|v| *v = (mean + std * *v as f64) as f32);
+            f
+        })
+        .collect()
+}
+
+/// Runs the evaluation: measures generated, fBm, reference and (for a prepared set) training
+/// tiles, writes the image to `args.out` and returns the table. `progress(done, total)` counts tiles.
+pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report, EvalError> {
+    if args.seam_stride < 2 {
+        return Err(EvalError::Input(format!("--seam-stride {} is too small (at least 2)", args.seam_stride)));
+    }
+    let reference = Reference::load(&args.reference)?;
+    let generated = Heightmap::load(&args.generated)?;
+    let (metres, size) = (reference.metres(), reference.tile);
+    let gen_tiles = generated.tiles_at(metres, size);
+    if gen_tiles.is_empty() {
+        return Err(EvalError::Input(format!("{} yields no tile to measure", args.generated.display())));
+    }
+    let ref_tiles = reference.heldout.tiles_at(metres, size);
+    let train_tiles = reference.train.as_ref().map(|t| t.tiles_at(metres, size)).unwrap_or_default();
+    let fbm_tiles = fbm_like(&gen_tiles);
+
+    // Seams are a property of the generator's grid: measure them at its native resolution on
+    // its own window lines; the other columns show the same statistic on lines the same
+    // distance apart, which is what "no seams" looks like.
+    let stride_metres = args.seam_stride as f64 * MODEL_PIXEL_METRES;
+    let ref_lines = SeamLines::for_origin(((stride_metres / metres).round() as usize).max(2), 0, 0);
+    let total = (gen_tiles.len() * 2 + ref_tiles.len() + train_tiles.len()) as u64;
+    let mut done = 0;
+    let mut set = |tiles: &[Raster]| {
+        let m = measure::measure(tiles, ref_lines, &mut |d, _| progress(done + d, total));
+        done += tiles.len() as u64;
+        m
+    };
+    let mut columns = vec![
+        Column { label: "reference".into(), colour: Rgb([20, 20, 20]), metrics: set(&ref_tiles) },
+        Column { label: "generated".into(), colour: Rgb([210, 40, 30]), metrics: set(&gen_tiles) },
+        Column { label: "fBm".into(), colour: Rgb([40, 90, 220]), metrics: set(&fbm_tiles) },
+    ];
+    if !train_tiles.is_empty() {
+        columns.push(Column { label: "train (real)".into(), colour: Rgb([130, 130, 130]), metrics: set(&train_tiles) });
+    }
+    columns[1].metrics.seams = native_seams(&generated, args.seam_stride);
+
+    let notes = notes(args, &reference, &generated, gen_tiles.len(), stride_metres);
+    let table = Report::new(notes, &columns, &format!("lines every {:.0} km", stride_metres / 1000.0));
+    let image = plot::draw(&table.notes, &[report::slope_panel(&columns), report::spectrum_panel(&columns)]);
+    save(&image, &args.out)?;
+    Ok(table)
+}
+
+/// The generated map's seam sums on its own window lines (whole map: its origin places the
+/// lines; a stack of tiles: lines from each tile's corner).
+fn native_seams(generated: &Heightmap, stride_model_px: usize) -> crate::terrain::metrics::SeamStats {
+    let stride = ((stride_model_px as f64 * generated.pixels_per_model_pixel).round() as usize).max(2);
+    let (x0, y0) = match (generated.tile, generated.origin) {
+        (None, Some(origin)) => origin,
+        _ => (0, 0),
+    };
+    let lines = SeamLines::for_origin(stride, x0, y0);
+    let mut stats = crate::terrain::metrics::SeamStats::default();
+    for piece in generated.pieces() {
+        stats.add(crate::terrain::metrics::seam_ratio(&piece, lines));
+    }
+    stats
+}
+
+fn notes(
+    args: &EvalArgs,
+    reference: &Reference,
+    generated: &Heightmap,
+    gen_tiles: usize,
+    stride_m: f64,
+) -> Vec<String> {
+    let (metres, size) = (reference.metres(), reference.tile);
+    let g = &generated.raster;
+    let mut notes = vec![
+        format!(
+            "reference: {} ({} m/px, {size}x{size} tiles){}",
+            args.reference.display(),
+            metres,
+            if reference.train.is_some() { "; held-out split vs train split" } else { "" }
+        ),
+        format!(
+            "generated: {} ({}x{} px at {} m/px) -> {gen_tiles} tiles",
+            args.generated.display(),
+            g.rows,
+            g.cols,
+            g.metres
+        ),
+    ];
+    if (g.metres - metres).abs() > 1e-6 * metres {
+        notes.push(format!("  resampled bilinearly from {} m to the reference's {} m per pixel", g.metres, metres));
+    }
+    notes.push(format!(
+        "fBm: β = {FBM_BETA}, seed {FBM_SEED:#x}, each tile matched to the generated tile's mean and std; \
+         seams on lines every {:.0} km (--seam-stride {} model px)",
+        stride_m / 1000.0,
+        args.seam_stride
+    ));
+    notes
+}
+
+fn save(image: &image::RgbImage, path: &Path) -> Result<(), EvalError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| EvalError::Output { path: path.to_path_buf(), source: image::ImageError::IoError(e) })?;
+    }
+    image.save(path).map_err(|source| EvalError::Output { path: path.to_path_buf(), source })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,227 @@
+//! The realism table (metrics × columns) and the panels of the report image.
+
+use std::fmt;
+
+use image::Rgb;
+
+use super::measure::SetMetrics;
+use super::plot::{Panel, Series};
+use crate::terrain::metrics::{chi2_distance, histogram, quantile_edges, wasserstein1};
+
+/// Quantile bins of the style histograms (fixed on the held-out reference).
+pub const STYLE_BINS: usize = 20;
+
+/// One column of the report: a set of tiles and how it is drawn.
+pub struct Column {
+    /// Header of the column.
+    pub label: String,
+    /// Colour in the image.
+    pub colour: Rgb<u8>,
+    /// Its metrics.
+    pub metrics: SetMetrics,
+}
+
+/// The report: context lines, then a table whose first column is the reference.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// What was compared, at which resolution, and any resampling.
+    pub notes: Vec<String>,
+    /// Column headers (reference first).
+    pub columns: Vec<String>,
+    /// (metric, one cell per column).
+    pub rows: Vec<(String, Vec<String>)>,
+}
+
+fn cell(v: f64, decimals: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.decimals$}")
+    } else {
+        "n/a".into()
+    }
+}
+
+impl Report {
+    /// Builds the table; `columns[0]` is the reference the distances are measured to.
+    pub fn new(notes: Vec<String>, columns: &[Column], seam_caption: &str) -> Report {
+        let reference = &columns[0].metrics;
+        let slope_edges = quantile_edges(&reference.slopes, STYLE_BINS);
+        let relief_edges = quantile_edges(&reference.relief, STYLE_BINS);
+        let slope_ref = histogram(&reference.slopes, &slope_edges);
+        let relief_ref = histogram(&reference.relief, &relief_edges);
+        let distance = |f: &dyn Fn(&SetMetrics) -> String| -> Vec<String> {
+            std::iter::once("-".to_string()).chain(columns[1..].iter().map(|c| f(&c.metrics))).collect()
+        };
+        let value =
+            |f: &dyn Fn(&SetMetrics) -> String| -> Vec<String> { columns.iter().map(|c| f(&c.metrics)).collect() };
+        let mean = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+        let rows = vec![
+            ("tiles".to_string(), value(&|m| m.tiles.to_string())),
+            ("land fraction (> 0 m)".into(), value(&|m| cell(m.land_fraction, 2))),
+            ("elevation std per tile (m)".into(), value(&|m| cell(m.mean_tile_std, 0))),
+            ("slope mean (°)".into(), value(&|m| cell(mean(&m.slopes), 2))),
+            ("slope W1 to reference (°)".into(), distance(&|m| cell(wasserstein1(&m.slopes, &reference.slopes), 2))),
+            (
+                format!("slope χ² to reference ({STYLE_BINS} bins)"),
+                distance(&|m| cell(chi2_distance(&histogram(&m.slopes, &slope_edges), &slope_ref), 3)),
+            ),
+            (
+                "rel. elevation W1 to reference (m)".into(),
+                distance(&|m| cell(wasserstein1(&m.relief, &reference.relief), 1)),
+            ),
+            (
+                format!("rel. elevation χ² to reference ({STYLE_BINS} bins)"),
+                distance(&|m| cell(chi2_distance(&histogram(&m.relief, &relief_edges), &relief_ref), 3)),
+            ),
+            ("spectral slope β (power ∝ k^β)".into(), value(&|m| cell(m.beta, 2))),
+            ("|Δβ| to reference".into(), distance(&|m| cell((m.beta - reference.beta).abs(), 2))),
+            ("depressions ≥ 1 m per 1000 km²".into(), value(&|m| cell(m.depressions.per_1000_km2(), 2))),
+            ("fill volume per area (m³/km²)".into(), value(&|m| cell(m.depressions.volume_per_km2(), 0))),
+            (format!("seam ratio ({seam_caption})"), value(&|m| cell(m.seams.ratio(), 3))),
+        ];
+        Report { notes, columns: columns.iter().map(|c| c.label.clone()).collect(), rows }
+    }
+
+    /// The cell of `metric` in column `column`, if both exist (for tests and scripts).
+    pub fn get(&self, metric: &str, column: usize) -> Option<&str> {
+        self.rows
+            .iter()
+            .find(|(m, _)| m.starts_with(metric))
+            .and_then(|(_, cells)| cells.get(column))
+            .map(|s| s.as_str())
+    }
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for n in &self.notes {
+            writeln!(f, "{n}")?;
+        }
+        let first = self.rows.iter().map(|(m, _)| m.chars().count()).max().unwrap_or(6).max(6);
+        let widths: Vec<usize> = self.columns.iter().map(|c| c.chars().count().max(10)).collect();
+        write!(f, "\n{:<first$}", "metric")?;
+        for (c, w) in self.columns.iter().zip(&widths) {
+            write!(f, "  {c:>w$}")?;
+        }
+        writeln!(f)?;
+        for (metric, cells) in &self.rows {
+            // Pad by characters, not bytes: the labels hold °, χ², β.
+            write!(f, "{metric}{}", " ".repeat(first - metric.chars().count()))?;
+            for (c, w) in cells.iter().zip(&widths) {
+                write!(f, "  {c:>w$}")?;
+            }
+            writeln!(f)?;
+        }
+        Ok(())
+    }
+}
+
+/// Slope histograms (percent of pixels per degree, log scale: real terrain's long tail of
+/// steep slopes is where noise and eroded relief differ) of every column.
+pub fn slope_panel(columns: &[Column]) -> Panel {
+    let top = columns
+        .iter()
+        .filter_map(|c| {
+            let mut s = c.metrics.slopes.clone();
+            s.sort_unstable_by(f32::total_cmp);
+            s.get(s.len().saturating_sub(1) * 995 / 1000).copied()
+        })
+        .fold(10.0f32, f32::max)
+        .min(90.0)
+        .ceil() as usize;
+    let edges: Vec<f64> = (1..=top).map(|d| d as f64).collect();
+    let series: Vec<Series> = columns
+        .iter()
+        .map(|c| {
+            let h = histogram(&c.metrics.slopes, &edges);
+            // The last bin is open-ended (everything steeper): not a per-degree density.
+            let points = h[..top]
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| **p > 0.0)
+                .map(|(d, p)| (d as f64 + 0.5, (100.0 * p).log10()))
+                .collect();
+            Series { label: c.label.clone(), colour: c.colour, points }
+        })
+        .collect();
+    let y_hi = series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).fold(0.0f64, f64::max).ceil().max(1.0);
+    let y_lo = -3.0;
+    Panel {
+        title: "slope distribution".into(),
+        x_caption: "slope (°)".into(),
+        y_caption: "% of pixels per degree, log scale".into(),
+        x_range: (0.0, top as f64),
+        y_range: (y_lo, y_hi),
+        x_ticks: ticks(0.0, top as f64, nice_step(top as f64 / 6.0)),
+        y_ticks: (y_lo as i32..=y_hi as i32).map(|d| (d as f64, decade(d))).collect(),
+        series,
+    }
+}
+
+/// A decade's label: plain numbers near 1, exponents beyond.
+fn decade(d: i32) -> String {
+    if (-2..=2).contains(&d) {
+        format!("{}", 10f64.powi(d))
+    } else {
+        format!("1e{d}")
+    }
+}
+
+/// Radially averaged power spectra (log-log) of every column.
+pub fn spectrum_panel(columns: &[Column]) -> Panel {
+    let series: Vec<Series> = columns
+        .iter()
+        .map(|c| {
+            let points = c.metrics.spectrum.as_ref().map_or_else(Vec::new, |s| {
+                s.frequency
+                    .iter()
+                    .zip(&s.power)
+                    .filter(|(_, p)| **p > 0.0)
+                    .map(|(f, p)| ((f * 1000.0).log10(), p.log10()))
+                    .collect()
+            });
+            Series { label: format!("{} β={}", c.label, cell(c.metrics.beta, 2)), colour: c.colour, points }
+        })
+        .collect();
+    let all = || series.iter().flat_map(|s| s.points.iter());
+    let (x_lo, x_hi) = all().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (y_lo, y_hi) = all().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let (x_lo, x_hi, y_lo, y_hi) =
+        if x_lo.is_finite() { (x_lo.floor(), x_hi.ceil(), y_lo.floor(), y_hi.ceil()) } else { (-3.0, 0.0, 0.0, 1.0) };
+    Panel {
+        title: "radially averaged power spectrum".into(),
+        x_caption: "frequency (cycles/km)".into(),
+        y_caption: "power (m^4), log scale".into(),
+        x_range: (x_lo, x_hi),
+        y_range: (y_lo, y_hi),
+        x_ticks: (x_lo as i32..=x_hi as i32).map(|d| (d as f64, decade(d))).collect(),
+        y_ticks: (y_lo as i32..=y_hi as i32)
+            .step_by(((y_hi - y_lo) / 6.0).ceil().max(1.0) as usize)
+            .map(|d| (d as f64, decade(d)))
+            .collect(),
+        series,
+    }
+}
+
+/// 1, 2 or 5 × 10ⁿ, the first at least `raw`.
+fn nice_step(raw: f64) -> f64 {
+    let base = 10f64.powf(raw.max(1e-9).log10().floor());
+    [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * base).find(|s| *s >= raw).unwrap_or(10.0 * base)
+}
+
+fn ticks(lo: f64, hi: f64, step: f64) -> Vec<(f64, String)> {
+    let n = ((hi - lo) / step).floor() as usize;
+    (0..=n).map(|k| lo + k as f64 * step).map(|v| (v, format!("{v}"))).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nice_steps_are_one_two_five() {
+        assert_eq!(nice_step(7.0), 10.0);
+        assert_eq!(nice_step(1.5), 2.0);
+        assert_eq!(nice_step(0.3), 0.5);
+        assert_eq!(ticks(0.0, 10.0, 5.0).len(), 3);
+    }
+}

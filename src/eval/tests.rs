@@ -1,0 +1,126 @@
+//! End to end on small synthetic files: a prepared-set directory and an exported map.
+
+use std::path::Path;
+
+use super::*;
+use crate::export::write_npy_f32;
+
+/// Terrain-like values: positive fBm relief (no sea) so every metric has something to see.
+fn hills(rows: usize, cols: usize, metres: f64, seed: u64) -> Raster {
+    let mut r = fbm(rows, cols, metres, -3.0, seed);
+    r.data.iter_mut().for_each(|v| *v = 800.0 + 300.0 * *v);
+    r
+}
+
+/// A stack of `n` tiles written as a prepared split: `name.npy` + `name.json`.
+fn write_split(dir: &Path, name: &str, n: usize, tile: usize, seed: u64) {
+    let data: Vec<f32> = (0..n).flat_map(|i| hills(tile, tile, 1000.0, seed + i as u64).data).collect();
+    write_npy_f32(&dir.join(format!("{name}.npy")), (n * tile, tile), &data).unwrap();
+    let side = serde_json::json!({"metres_per_pixel": 1000.0, "tile": tile, "count": n, "split": name});
+    std::fs::write(dir.join(format!("{name}.json")), side.to_string()).unwrap();
+}
+
+/// A generated map at 500 m with an export sidecar.
+fn write_generated(path: &Path, side: usize) {
+    let r = hills(side, side, 500.0, 99);
+    write_npy_f32(path, (side, side), &r.data).unwrap();
+    let meta = serde_json::json!({
+        "x0": -256, "z0": 128, "width": side, "height": side, "grid": "model", "metres_per_pixel": 500.0,
+        "seed": 1, "stages": ["layout"], "vertical": {"sea_level_y": 63, "metres_per_block": 25.0}
+    });
+    std::fs::write(path.with_extension("json"), meta.to_string()).unwrap();
+}
+
+fn args(generated: &Path, reference: &Path, out: &Path) -> EvalArgs {
+    EvalArgs { generated: generated.into(), reference: reference.into(), out: out.into(), seam_stride: 32 }
+}
+
+#[test]
+fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = dir.path().join("core");
+    std::fs::create_dir(&set).unwrap();
+    write_split(&set, "heldout", 2, 64, 1);
+    write_split(&set, "train", 3, 64, 10);
+    let generated = dir.path().join("gen.npy");
+    write_generated(&generated, 256);
+    let out = dir.path().join("report/eval.png");
+
+    let mut calls = 0;
+    let report = run(&args(&generated, &set, &out), &mut |_, _| calls += 1).unwrap();
+    let text = report.to_string();
+    for row in [
+        "slope mean",
+        "slope W1",
+        "slope χ²",
+        "rel. elevation W1",
+        "spectral slope β",
+        "|Δβ|",
+        "depressions",
+        "fill volume",
+        "seam ratio",
+    ] {
+        assert!(text.contains(row), "row {row} missing:\n{text}");
+    }
+    assert_eq!(report.columns, ["reference", "generated", "fBm", "train (real)"]);
+    // 256² at 500 m → 128² at 1000 m → four 64² tiles, and as many fBm tiles.
+    assert_eq!(report.get("tiles", 1), Some("4"));
+    assert_eq!(report.get("tiles", 2), Some("4"));
+    assert_eq!(report.get("tiles", 3), Some("3"));
+    assert_eq!(report.get("slope W1", 0), Some("-"), "no distance of the reference to itself");
+    assert!(text.contains("resampled bilinearly from 500 m"), "{text}");
+    assert_eq!(calls, 4 + 4 + 2 + 3, "progress once per tile");
+    let beta: f64 = report.get("spectral slope", 2).unwrap().parse().unwrap();
+    assert!((-3.6..=-2.4).contains(&beta), "fBm baseline β = {beta}");
+    let seam: f64 = report.get("seam ratio", 1).unwrap().parse().unwrap();
+    assert!((0.8..1.25).contains(&seam), "seamless noise has seam ratio ≈ 1, got {seam}");
+    let img = image::open(&out).unwrap();
+    assert!(img.width() >= 1000 && img.height() >= 400);
+}
+
+#[test]
+fn a_single_reference_file_has_no_train_column() {
+    let dir = tempfile::tempdir().unwrap();
+    write_split(dir.path(), "ref", 1, 64, 3);
+    let generated = dir.path().join("gen.npy");
+    write_generated(&generated, 64);
+    let report =
+        run(&args(&generated, &dir.path().join("ref.npy"), &dir.path().join("r.png")), &mut |_, _| {}).unwrap();
+    assert_eq!(report.columns, ["reference", "generated", "fBm"]);
+}
+
+#[test]
+fn bad_inputs_are_input_errors_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let generated = dir.path().join("gen.npy");
+    write_generated(&generated, 64);
+    let missing = dir.path().join("nowhere");
+    let err = run(&args(&generated, &missing, &dir.path().join("r.png")), &mut |_, _| {}).unwrap_err();
+    assert!(matches!(&err, EvalError::Input(m) if m.contains("nowhere")), "{err}");
+
+    write_split(dir.path(), "ref", 1, 64, 3);
+    std::fs::remove_file(generated.with_extension("json")).unwrap();
+    let err =
+        run(&args(&generated, &dir.path().join("ref.npy"), &dir.path().join("r.png")), &mut |_, _| {}).unwrap_err();
+    assert!(matches!(&err, EvalError::Input(m) if m.contains("gen.json")), "{err}");
+
+    std::fs::write(generated.with_extension("json"), r#"{"metres_per_pixel": -1}"#).unwrap();
+    let err =
+        run(&args(&generated, &dir.path().join("ref.npy"), &dir.path().join("r.png")), &mut |_, _| {}).unwrap_err();
+    assert!(err.to_string().contains("metres_per_pixel"), "{err}");
+}
+
+#[test]
+fn seams_of_the_generated_map_follow_its_window_lines() {
+    // Steps of 200 m on every model-pixel column x ≡ 0 (mod 32) in global coordinates; the map
+    // starts at block x −256 = model pixel −64, so the lines fall on array columns 0, 32, 64.
+    let dir = tempfile::tempdir().unwrap();
+    let generated = dir.path().join("gen.npy");
+    write_generated(&generated, 128);
+    let mut map = Heightmap::load(&generated).unwrap();
+    assert_eq!(map.origin, Some((-64, 32)));
+    let smooth = native_seams(&map, 32).ratio();
+    map.raster = Raster::from_fn(128, 128, 500.0, |y, x| map.raster.at(y, x) + 200.0 * (x / 32) as f32);
+    let stepped = native_seams(&map, 32).ratio();
+    assert!(stepped > smooth * 1.3, "steps on the window lines: {stepped} vs {smooth}");
+}

@@ -1,0 +1,190 @@
+//! What the ground is made of: the top block and the layer under it, from the biome, the
+//! steepness, the temperature and whether the sea covers it.
+//!
+//! Pure functions of their inputs; the chunk builder stacks the result on stone.
+
+use valence::prelude::BlockState;
+
+use super::hash::value_noise;
+
+/// Everything the choice depends on for one column.
+#[derive(Clone, Copy, Debug)]
+pub struct Site<'a> {
+    /// Biome of the cell holding the surface block (`"minecraft:desert"`).
+    pub biome: &'a str,
+    /// Blocks of water above the surface block (0 on land and on shores level with the sea).
+    pub water_depth: i32,
+    /// Blocks the ground falls to its lowest neighbour (see `Columns::drop_blocks`).
+    pub drop_blocks: i32,
+    /// Annual mean air temperature at the surface, °C.
+    pub temperature_c: f32,
+    /// World seed (for patch noise).
+    pub seed: u64,
+    /// Global block coordinates of the column.
+    pub x: i64,
+    /// Global block coordinates of the column.
+    pub z: i64,
+}
+
+/// The ground of one column, top down: `top`, then `filler` for `filler_depth` blocks (or
+/// terracotta bands where `banded`), then stone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ground {
+    /// The surface block.
+    pub top: BlockState,
+    /// The blocks under it.
+    pub filler: BlockState,
+    /// How many filler blocks.
+    pub filler_depth: i32,
+    /// Badlands: fill with horizontal terracotta bands (by Y) instead of `filler`.
+    pub banded: bool,
+}
+
+/// A fall of this many blocks to a neighbour shows bare rock (about 37° at 25 m per block).
+pub const STEEP_DROP_BLOCKS: i32 = 3;
+/// Annual mean temperature below which exposed land is snow-covered, °C.
+pub const SNOW_LINE_C: f32 = -4.0;
+/// Below this temperature snow fields hold pockets of powder snow, °C.
+pub const POWDER_SNOW_C: f32 = -12.0;
+/// Below this temperature the sea surface freezes, °C.
+pub const SEA_ICE_C: f32 = 0.0;
+
+const NOISE_POWDER: u64 = 0x5057_4452;
+
+/// Chooses the ground of one column.
+pub fn ground(site: &Site) -> Ground {
+    let b = site.biome.strip_prefix("minecraft:").unwrap_or(site.biome);
+    let steep = site.drop_blocks >= STEEP_DROP_BLOCKS;
+    let layer = |top, filler, filler_depth| Ground { top, filler, filler_depth, banded: false };
+
+    if site.water_depth > 0 {
+        return underwater(b, site.water_depth, site.temperature_c);
+    }
+    if b.contains("badlands") {
+        // Badlands show their banded terracotta on every slope; red sand only on flats.
+        let top = if steep { BlockState::TERRACOTTA } else { BlockState::RED_SAND };
+        return Ground { top, filler: BlockState::TERRACOTTA, filler_depth: 14, banded: true };
+    }
+    if steep {
+        return layer(BlockState::STONE, BlockState::STONE, 0);
+    }
+    let snowy = b.starts_with("snowy_")
+        || b.starts_with("frozen_")
+        || matches!(b, "jagged_peaks" | "grove" | "ice_spikes")
+        || site.temperature_c < SNOW_LINE_C;
+    if snowy && !matches!(b, "desert" | "beach" | "stony_shore") {
+        let powder =
+            site.temperature_c < POWDER_SNOW_C && value_noise(site.seed, NOISE_POWDER, site.x, site.z, 6) > 0.72;
+        let top = if powder { BlockState::POWDER_SNOW } else { BlockState::SNOW_BLOCK };
+        return layer(top, if powder { BlockState::POWDER_SNOW } else { BlockState::DIRT }, if powder { 1 } else { 2 });
+    }
+    match b {
+        "desert" => layer(BlockState::SAND, BlockState::SANDSTONE, 4),
+        "beach" | "snowy_beach" => layer(BlockState::SAND, BlockState::SAND, 3),
+        "stony_shore" | "stony_peaks" => layer(BlockState::STONE, BlockState::STONE, 0),
+        "old_growth_pine_taiga" | "old_growth_spruce_taiga" => layer(BlockState::PODZOL, BlockState::DIRT, 3),
+        "mangrove_swamp" => layer(BlockState::MUD, BlockState::MUD, 3),
+        "windswept_gravelly_hills" => layer(BlockState::GRAVEL, BlockState::GRAVEL, 2),
+        "mushroom_fields" => layer(BlockState::MYCELIUM, BlockState::DIRT, 3),
+        "savanna_plateau" | "windswept_savanna" => layer(BlockState::GRASS_BLOCK, BlockState::COARSE_DIRT, 3),
+        _ => layer(BlockState::GRASS_BLOCK, BlockState::DIRT, 3),
+    }
+}
+
+fn underwater(biome: &str, depth: i32, temperature_c: f32) -> Ground {
+    let cold = biome.contains("cold") || biome.contains("frozen") || temperature_c < SEA_ICE_C;
+    let warm = biome.contains("warm") || biome.contains("lukewarm");
+    let top = match biome {
+        "mangrove_swamp" | "swamp" => BlockState::MUD,
+        _ if cold => BlockState::GRAVEL,
+        _ if warm => BlockState::SAND,
+        // Sandy shallows, gravel in the deep.
+        _ if depth <= 12 => BlockState::SAND,
+        _ => BlockState::GRAVEL,
+    };
+    Ground { top, filler: top, filler_depth: 3, banded: false }
+}
+
+/// The terracotta of badlands band at block `y` (repeating every 16 blocks, like strata).
+pub fn terracotta_band(y: i32) -> BlockState {
+    const BANDS: [BlockState; 16] = [
+        BlockState::TERRACOTTA,
+        BlockState::ORANGE_TERRACOTTA,
+        BlockState::ORANGE_TERRACOTTA,
+        BlockState::TERRACOTTA,
+        BlockState::YELLOW_TERRACOTTA,
+        BlockState::TERRACOTTA,
+        BlockState::TERRACOTTA,
+        BlockState::BROWN_TERRACOTTA,
+        BlockState::TERRACOTTA,
+        BlockState::RED_TERRACOTTA,
+        BlockState::RED_TERRACOTTA,
+        BlockState::TERRACOTTA,
+        BlockState::WHITE_TERRACOTTA,
+        BlockState::TERRACOTTA,
+        BlockState::LIGHT_GRAY_TERRACOTTA,
+        BlockState::ORANGE_TERRACOTTA,
+    ];
+    BANDS[y.rem_euclid(16) as usize]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn site(biome: &str) -> Site<'_> {
+        Site { biome, water_depth: 0, drop_blocks: 0, temperature_c: 15.0, seed: 1, x: 0, z: 0 }
+    }
+
+    #[test]
+    fn biomes_choose_their_surface() {
+        assert_eq!(ground(&site("minecraft:plains")).top, BlockState::GRASS_BLOCK);
+        assert_eq!(ground(&site("minecraft:desert")).top, BlockState::SAND);
+        assert_eq!(ground(&site("minecraft:desert")).filler, BlockState::SANDSTONE);
+        assert_eq!(ground(&site("minecraft:badlands")).top, BlockState::RED_SAND);
+        assert!(ground(&site("minecraft:eroded_badlands")).banded);
+        assert_eq!(ground(&site("minecraft:old_growth_spruce_taiga")).top, BlockState::PODZOL);
+        assert_eq!(ground(&site("minecraft:mangrove_swamp")).top, BlockState::MUD);
+        assert_eq!(ground(&site("minecraft:windswept_gravelly_hills")).top, BlockState::GRAVEL);
+    }
+
+    #[test]
+    fn steep_ground_is_bare_rock_except_in_badlands() {
+        let steep = |b| Site { drop_blocks: STEEP_DROP_BLOCKS, ..site(b) };
+        assert_eq!(ground(&steep("minecraft:plains")).top, BlockState::STONE);
+        assert_eq!(
+            ground(&Site { drop_blocks: STEEP_DROP_BLOCKS - 1, ..site("minecraft:plains") }).top,
+            BlockState::GRASS_BLOCK
+        );
+        assert_eq!(ground(&steep("minecraft:badlands")).top, BlockState::TERRACOTTA);
+    }
+
+    #[test]
+    fn cold_ground_is_snow_and_very_cold_ground_has_powder_snow_somewhere() {
+        let cold = Site { temperature_c: SNOW_LINE_C - 1.0, ..site("minecraft:plains") };
+        assert_eq!(ground(&cold).top, BlockState::SNOW_BLOCK);
+        assert_eq!(ground(&site("minecraft:snowy_plains")).top, BlockState::SNOW_BLOCK);
+        let tops: Vec<BlockState> = (0..64)
+            .flat_map(|x| (0..64).map(move |z| (x, z)))
+            .map(|(x, z)| ground(&Site { temperature_c: -20.0, x, z, ..site("minecraft:frozen_peaks") }).top)
+            .collect();
+        assert!(tops.contains(&BlockState::POWDER_SNOW));
+        assert!(tops.contains(&BlockState::SNOW_BLOCK));
+    }
+
+    #[test]
+    fn sea_floors_are_sand_shallow_and_gravel_deep_or_cold() {
+        let wet = |b, depth, t| ground(&Site { water_depth: depth, temperature_c: t, ..site(b) }).top;
+        assert_eq!(wet("minecraft:ocean", 3, 15.0), BlockState::SAND);
+        assert_eq!(wet("minecraft:deep_ocean", 40, 15.0), BlockState::GRAVEL);
+        assert_eq!(wet("minecraft:cold_ocean", 3, 15.0), BlockState::GRAVEL);
+        assert_eq!(wet("minecraft:warm_ocean", 40, 25.0), BlockState::SAND);
+    }
+
+    #[test]
+    fn bands_repeat_every_sixteen_blocks() {
+        for y in -64..64 {
+            assert_eq!(terracotta_band(y), terracotta_band(y + 16));
+        }
+    }
+}

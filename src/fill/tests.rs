@@ -1,0 +1,163 @@
+//! Whole-chunk tests: chunks agree with the per-column surface function (which queries the
+//! pipeline over different rectangles, so this is also the seam test), are deterministic,
+//! and are layered as documented.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use valence::prelude::{Biome, BiomeRegistry, BlockState, Chunk, Ident, UnloadedChunk};
+
+use super::*;
+use crate::biome::BiomeRules;
+
+const RULES: &str = r#"
+fallback = "minecraft:plains"
+
+[[rule]]
+name = "sea"
+biome = "minecraft:ocean"
+elevation_m = [-inf, 0]
+override = true
+
+[[rule]]
+name = "high cold air"
+biome = "minecraft:snowy_plains"
+temperature_c = [-inf, -10]
+override = true
+
+[[rule]]
+name = "steep"
+biome = "minecraft:windswept_hills"
+slope_deg = [8, 90]
+"#;
+
+fn rules() -> BiomeRules {
+    match BiomeRules::from_sources(&[(PathBuf::from("test.toml"), RULES.to_string())]) {
+        Ok(rules) => rules,
+        Err(e) => panic!("test rules do not load: {e}"),
+    }
+}
+
+fn palette() -> BiomePalette {
+    let mut registry = BiomeRegistry::default();
+    for name in vanilla_biome_names() {
+        if let Ok(ident) = Ident::new(name) {
+            registry.insert(ident, Biome::default());
+        }
+    }
+    BiomePalette::from_registry(&registry)
+}
+
+fn generator(seed: u64) -> Generator {
+    let mut config = Config::default();
+    config.world.seed = seed;
+    Generator::new(Arc::new(Pipeline::new(seed, &config.terrain())), &config)
+}
+
+/// Highest non-air block of a chunk column: (world Y, block).
+fn top(chunk: &UnloadedChunk, v: &Vertical, lx: u32, lz: u32) -> (i32, BlockState) {
+    (0..chunk.height())
+        .rev()
+        .map(|y| (y, chunk.block_state(lx, y, lz)))
+        .find(|(_, b)| !b.is_air())
+        .map_or((v.min_y, BlockState::AIR), |(y, b)| (y as i32 + v.min_y, b))
+}
+
+#[test]
+fn chunks_agree_with_the_surface_function_across_chunk_borders() {
+    let (g, rules, palette) = (generator(11), rules(), palette());
+    let v = *g.vertical();
+    for (cx, cz) in [(0, 0), (1, 0), (-1, -1)] {
+        let chunk = g.chunk(&rules, &palette, cx, cz);
+        for lz in 0..16u32 {
+            for lx in 0..16u32 {
+                let (x, z) = (i64::from(cx) * 16 + i64::from(lx), i64::from(cz) * 16 + i64::from(lz));
+                let s = g.surface(&rules, x, z);
+                let (top_y, top_block) = top(&chunk, &v, lx, lz);
+                if s.y >= v.water_top_y() {
+                    assert_eq!(top_y, s.y, "column ({x}, {z})");
+                    assert_eq!(top_block.to_kind().to_str(), s.top, "column ({x}, {z})");
+                } else {
+                    assert_eq!(top_y, v.water_top_y(), "sea column ({x}, {z})");
+                    assert!(matches!(top_block, BlockState::WATER | BlockState::ICE));
+                    let floor = chunk.block_state(lx, (s.y - v.min_y) as u32, lz);
+                    assert_eq!(floor.to_kind().to_str(), s.top, "sea floor ({x}, {z})");
+                }
+                let cell_y = ((s.y - v.min_y) / 4) as u32;
+                assert_eq!(chunk.biome(lx / 4, cell_y, lz / 4), palette.id(&s.biome), "biome at ({x}, {}, {z})", s.y);
+            }
+        }
+    }
+}
+
+#[test]
+fn chunks_are_deterministic() {
+    let (rules, palette) = (rules(), palette());
+    let a = generator(5).chunk(&rules, &palette, 3, -2);
+    let b = generator(5).chunk(&rules, &palette, 3, -2);
+    for y in 0..a.height() {
+        for z in 0..16 {
+            for x in 0..16 {
+                assert_eq!(a.block_state(x, y, z), b.block_state(x, y, z));
+            }
+        }
+    }
+    for y in 0..a.height() / 4 {
+        for z in 0..4 {
+            for x in 0..4 {
+                assert_eq!(a.biome(x, y, z), b.biome(x, y, z));
+            }
+        }
+    }
+}
+
+#[test]
+fn columns_are_bedrock_then_deepslate_then_stone_under_the_ground() {
+    let g = generator(3);
+    let v = *g.vertical();
+    let chunk = g.chunk(&rules(), &palette(), 0, 0);
+    for (lx, lz) in [(0, 0), (7, 9), (15, 15)] {
+        let at = |y: i32| chunk.block_state(lx, (y - v.min_y) as u32, lz);
+        assert_eq!(at(v.min_y), BlockState::BEDROCK);
+        assert_eq!(at(v.min_y + 1), BlockState::DEEPSLATE);
+        assert_eq!(at(-1), BlockState::DEEPSLATE);
+        assert_eq!(at(0), BlockState::STONE);
+    }
+}
+
+#[test]
+fn biomes_vary_with_height_as_the_air_cools() {
+    let (g, rules, palette) = (generator(2), rules(), palette());
+    let chunk = g.chunk(&rules, &palette, 0, 0);
+    let top_cell = chunk.height() / 4 - 1;
+    let snowy = palette.id("minecraft:snowy_plains");
+    // 6.5 °C/km over the 6 km of air above the sea: the highest cells are always cold.
+    for z in 0..4 {
+        for x in 0..4 {
+            assert_eq!(chunk.biome(x, top_cell, z), snowy, "cell ({x}, {z})");
+        }
+    }
+    let distinct: std::collections::HashSet<_> = (0..=top_cell).map(|y| chunk.biome(1, y, 1)).collect();
+    assert!(distinct.len() >= 2, "one biome from bedrock to sky: {distinct:?}");
+}
+
+#[test]
+fn the_sea_is_water_up_to_the_water_top_and_frozen_where_cold() {
+    // Find an ocean chunk near the origin, then check its water column.
+    let (g, rules, palette) = (generator(1), rules(), palette());
+    let v = *g.vertical();
+    let sea = (-40..40)
+        .flat_map(|z| (-40..40).map(move |x| (x, z)))
+        .find(|&(x, z)| g.surface(&rules, x * 16 + 8, z * 16 + 8).y < v.water_top_y() - 3);
+    let Some((cx, cz)) = sea else {
+        panic!("no sea within 640 blocks of the origin for seed 1");
+    };
+    let chunk = g.chunk(&rules, &palette, cx as i32, cz as i32);
+    let s = g.surface(&rules, cx * 16 + 8, cz * 16 + 8);
+    for y in s.y + 1..v.water_top_y() {
+        assert_eq!(chunk.block_state(8, (y - v.min_y) as u32, 8), BlockState::WATER, "y {y}");
+    }
+    let surface = chunk.block_state(8, (v.water_top_y() - v.min_y) as u32, 8);
+    assert!(matches!(surface, BlockState::WATER | BlockState::ICE));
+    assert_eq!(chunk.block_state(8, (v.sea_level_y - v.min_y) as u32, 8), BlockState::AIR);
+}

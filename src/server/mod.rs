@@ -1,0 +1,101 @@
+//! `infiniterra serve`: the Minecraft server (Java Edition 1.20.1, valence).
+//!
+//! Owns: the valence app, players joining and their spawn, streaming chunks to their views,
+//! the console, start-up and shutdown. Must not touch: how terrain is made (asks
+//! [`Pipeline`](crate::terrain::Pipeline) through [`fill`](crate::fill)) or how blocks are
+//! chosen (the fill's). Data flows one way: server → fill → pipeline.
+
+mod console;
+mod lifecycle;
+mod players;
+mod spawn;
+mod stream;
+mod world;
+
+use std::net::{SocketAddr, TcpListener};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use valence::prelude::*;
+
+use crate::biome::BiomeRules;
+use crate::config::Config;
+use crate::fill::Generator;
+use crate::terrain::Pipeline;
+
+pub use spawn::find_spawn;
+
+/// Options of `infiniterra serve` beyond the configuration file.
+#[derive(Clone, Debug)]
+pub struct ServeOptions {
+    /// Folder of biome rule files (`*.toml`), re-read by the console's `reload`.
+    pub biomes_dir: PathBuf,
+}
+
+/// Why the server could not start or stopped with an error.
+#[derive(Debug, thiserror::Error)]
+pub enum ServeError {
+    /// Bad input from the owner (biome rules, configuration): exit code 2.
+    #[error("{0:#}")]
+    Input(anyhow::Error),
+    /// Anything else (the address is taken, a thread could not start): exit code 1.
+    #[error("{0:#}")]
+    Runtime(anyhow::Error),
+}
+
+/// Runs the server until `stop` on the console, Ctrl-C or SIGTERM.
+pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> {
+    let rules = BiomeRules::load_dir(&options.biomes_dir)
+        .map_err(|e| ServeError::Input(anyhow::anyhow!("{}: {e}", options.biomes_dir.display())))?;
+    world::check_biome_names(&rules).map_err(ServeError::Input)?;
+
+    let address = config.bind_address();
+    check_address_free(address).map_err(ServeError::Runtime)?;
+    if !config.server.online_mode {
+        eprintln!(
+            "WARNING: offline mode (server.online_mode = false): anyone who can reach {address} can join under \
+             any name, without Mojang's account check. Only expose this server to people you trust."
+        );
+    }
+
+    let pipeline = Arc::new(Pipeline::new(config.world.seed, &config.terrain()));
+    let generator = Arc::new(Generator::new(pipeline, config));
+    println!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
+    let spawn = find_spawn(&generator, &rules);
+    println!("spawn point: x {} y {} z {}", spawn.block.x, spawn.block.y, spawn.block.z);
+
+    let exit = lifecycle::ExitCode::default();
+    let mut app = App::new();
+    app.insert_resource(NetworkSettings {
+        connection_mode: if config.server.online_mode {
+            ConnectionMode::Online { prevent_proxy_connections: false }
+        } else {
+            ConnectionMode::Offline
+        },
+        address,
+        max_players: config.server.max_players as usize,
+        ..Default::default()
+    })
+    .add_plugins(DefaultPlugins)
+    .insert_resource(world::WorldSetup {
+        config: config.clone(),
+        generator,
+        rules: Arc::new(rules),
+        biomes_dir: options.biomes_dir.clone(),
+    })
+    .insert_resource(spawn)
+    .insert_resource(exit.clone());
+    world::build(&mut app);
+    players::build(&mut app, config);
+    stream::build(&mut app);
+    console::build(&mut app);
+    lifecycle::build(&mut app, address).map_err(ServeError::Runtime)?;
+    app.run();
+    exit.result()
+}
+
+/// Fails early, with a clear message, when the address cannot be listened on (valence would
+/// only log it and run without listening).
+fn check_address_free(address: SocketAddr) -> anyhow::Result<()> {
+    TcpListener::bind(address).map(drop).map_err(|e| anyhow::anyhow!("cannot listen on {address}: {e}"))
+}

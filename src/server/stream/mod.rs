@@ -1,0 +1,210 @@
+//! Streaming chunks to players: what every view needs, nearest first, built off the main
+//! thread, cached when players move on, unloaded when nobody sees them.
+//!
+//! Unloading is decided from the players' views ([`ChunkView::contains`]), never from
+//! valence's viewer counts, which underflow when clients leave (valence issue #716).
+
+mod cache;
+mod workers;
+
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use valence::app::AppExit;
+use valence::prelude::*;
+
+use self::cache::ChunkCache;
+use self::workers::{Finished, Results, Workers};
+use super::players::PlayersSet;
+use super::world::{Palette, WorldSetup};
+use crate::biome::BiomeRules;
+
+/// How far back "chunks generated per second" looks.
+const RATE_WINDOW: Duration = Duration::from_secs(10);
+
+/// The streaming state: workers, finished-chunk cache and counters.
+#[derive(Resource)]
+pub struct Streamer {
+    workers: Workers,
+    results: Results,
+    cache: ChunkCache,
+    /// Chunks whose building panicked: not retried until the rules change.
+    failed: HashSet<ChunkPos>,
+    /// Rules generation each loaded chunk was built with (only current ones are cached).
+    loaded: HashMap<ChunkPos, u64>,
+    last_views: Vec<ChunkView>,
+    /// Something changed that may change the wish list.
+    dirty: bool,
+    stats: Stats,
+}
+
+/// Counters for the console's `status`.
+#[derive(Default)]
+struct Stats {
+    generated: u64,
+    failed: u64,
+    build_time: Duration,
+    recent: VecDeque<Instant>,
+}
+
+/// A snapshot of the streaming counters.
+#[derive(Clone, Debug)]
+pub struct StreamStatus {
+    /// Chunks built since start-up.
+    pub generated: u64,
+    /// Chunks built per second over the last ten seconds.
+    pub per_second: f64,
+    /// Mean time to build one chunk on a worker.
+    pub mean_build: Duration,
+    /// Chunks whose building failed.
+    pub failed: u64,
+    /// Chunks wanted and not yet started.
+    pub queued: usize,
+    /// Chunks being built now.
+    pub in_flight: usize,
+    /// Finished chunks kept for revisits.
+    pub cached: usize,
+    /// Chunks loaded in the world (in some player's view).
+    pub loaded: usize,
+}
+
+impl Streamer {
+    /// The counters now.
+    pub fn status(&mut self) -> StreamStatus {
+        self.trim_recent();
+        let (queued, in_flight) = self.workers.counts();
+        let s = &self.stats;
+        StreamStatus {
+            generated: s.generated,
+            per_second: s.recent.len() as f64 / RATE_WINDOW.as_secs_f64(),
+            mean_build: s.build_time.checked_div(s.generated.max(1) as u32).unwrap_or_default(),
+            failed: s.failed,
+            queued,
+            in_flight,
+            cached: self.cache.len(),
+            loaded: self.loaded.len(),
+        }
+    }
+
+    /// New chunks are built with `rules`; cached chunks built with the old ones are dropped
+    /// so revisited places show the new rules too (chunks on screen stay as they are).
+    pub fn set_rules(&mut self, rules: Arc<BiomeRules>) {
+        self.workers.set_rules(rules);
+        self.cache.clear();
+        self.failed.clear();
+        self.dirty = true;
+    }
+
+    fn trim_recent(&mut self) {
+        let now = Instant::now();
+        while self.stats.recent.front().is_some_and(|t| now.duration_since(*t) > RATE_WINDOW) {
+            self.stats.recent.pop_front();
+        }
+    }
+}
+
+/// Adds the streaming systems.
+pub fn build(app: &mut App) {
+    app.add_systems(PostStartup, start_workers).add_systems(Update, stream_chunks.after(PlayersSet));
+}
+
+fn start_workers(
+    mut commands: Commands,
+    setup: Res<WorldSetup>,
+    palette: Res<Palette>,
+    mut exit: EventWriter<AppExit>,
+) {
+    let (done, results) = mpsc::channel();
+    let threads = setup.config.server.chunk_threads as usize;
+    match Workers::start(threads, setup.generator.clone(), palette.0.clone(), setup.rules.clone(), done) {
+        Ok(workers) => commands.insert_resource(Streamer {
+            workers,
+            results: Results::new(results),
+            cache: ChunkCache::new(setup.config.server.chunk_cache as usize),
+            failed: HashSet::new(),
+            loaded: HashMap::new(),
+            last_views: Vec::new(),
+            dirty: true,
+            stats: Stats::default(),
+        }),
+        Err(e) => {
+            tracing::error!("cannot start chunk worker threads: {e}");
+            exit.send(AppExit);
+        }
+    }
+}
+
+/// Once per tick: take in finished chunks, unload what no view holds, and hand the workers
+/// a fresh nearest-first wish list when anything changed. Never waits on a worker.
+fn stream_chunks(
+    mut layers: Query<&mut ChunkLayer>,
+    clients: Query<View, (With<Client>, Without<Despawned>)>,
+    streamer: Option<ResMut<Streamer>>,
+) {
+    let (Some(mut streamer), Ok(mut layer)) = (streamer, layers.get_single_mut()) else {
+        return;
+    };
+    let s = &mut *streamer;
+    let views: Vec<ChunkView> = clients.iter().map(|v| v.get()).collect();
+    let wanted = |pos: ChunkPos| views.iter().any(|v| v.contains(pos));
+    let generation = s.workers.generation();
+
+    for Finished { pos, chunk, generation: built_with, elapsed } in s.results.drain() {
+        s.workers.finished(pos);
+        s.dirty = true;
+        let Some(chunk) = chunk else {
+            s.stats.failed += 1;
+            s.failed.insert(pos);
+            tracing::error!("building chunk {} {} failed (see the panic above); it stays empty", pos.x, pos.z);
+            continue;
+        };
+        s.stats.generated += 1;
+        s.stats.build_time += elapsed;
+        s.stats.recent.push_back(Instant::now());
+        if wanted(pos) && layer.chunk(pos).is_none() {
+            layer.insert_chunk(pos, chunk);
+            s.loaded.insert(pos, built_with);
+        } else if built_with == generation {
+            s.cache.put(pos, chunk);
+        }
+    }
+    s.trim_recent();
+
+    if views != s.last_views {
+        s.dirty = true;
+        let gone: Vec<ChunkPos> = layer.chunks().map(|(pos, _)| pos).filter(|&pos| !wanted(pos)).collect();
+        for pos in gone {
+            let built_with = s.loaded.remove(&pos);
+            if let Some(chunk) = layer.remove_chunk(pos) {
+                if built_with == Some(generation) {
+                    s.cache.put(pos, chunk);
+                }
+            }
+        }
+        s.last_views = views.clone();
+    }
+
+    if s.dirty {
+        s.dirty = false;
+        let mut nearest: HashMap<ChunkPos, u64> = HashMap::new();
+        for view in &views {
+            for pos in view.iter() {
+                if layer.chunk(pos).is_some() || s.failed.contains(&pos) {
+                    continue;
+                }
+                if let Some(chunk) = s.cache.take(pos) {
+                    layer.insert_chunk(pos, chunk);
+                    s.loaded.insert(pos, generation);
+                    continue;
+                }
+                let d = view.pos.distance_squared(pos);
+                nearest.entry(pos).and_modify(|e| *e = (*e).min(d)).or_insert(d);
+            }
+        }
+        let mut list: Vec<(u64, ChunkPos)> = nearest.into_iter().map(|(pos, d)| (d, pos)).collect();
+        list.sort_unstable_by_key(|&(d, pos)| (d, pos.x, pos.z));
+        s.workers.set_wanted(list.into_iter().map(|(_, pos)| pos));
+    }
+}

@@ -1,0 +1,209 @@
+//! Chunk workers: threads that take the nearest wanted chunk, build it, and hand it back.
+//!
+//! The main thread owns the wish list and rewrites it whenever views change, so a chunk that
+//! is no longer wanted is simply gone from the list before any worker starts it (cancelled
+//! for free). Only the `threads` chunks being built are ever in flight. The main thread only
+//! ever holds the lock for a swap or a counter read: it never waits on terrain.
+
+use std::collections::HashSet;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::mpsc::{Receiver, Sender};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
+use std::thread::{self, JoinHandle};
+use std::time::{Duration, Instant};
+
+use valence::prelude::{ChunkPos, UnloadedChunk};
+use valence::protocol::{CompressionThreshold, PacketEncoder};
+
+use crate::biome::BiomeRules;
+use crate::fill::{BiomePalette, Generator, SkyLight};
+
+/// A chunk ready to insert, with its sky light as a ready-to-send packet.
+pub struct Built {
+    /// The blocks and biomes.
+    pub chunk: UnloadedChunk,
+    /// The encoded (and, above the threshold, compressed) `LightUpdateS2c` for it.
+    pub light: Arc<[u8]>,
+}
+
+/// A chunk a worker finished (or failed to build).
+pub struct Finished {
+    /// Where it goes.
+    pub pos: ChunkPos,
+    /// The chunk; `None` when building it failed (a bug, logged by the server).
+    pub built: Option<Built>,
+    /// The rules generation it was built with (see [`Workers::set_rules`]).
+    pub generation: u64,
+    /// How long it took.
+    pub elapsed: Duration,
+}
+
+struct Queue {
+    /// Wanted chunks, farthest first: workers pop the nearest from the end.
+    pending: Vec<ChunkPos>,
+    in_flight: HashSet<ChunkPos>,
+    rules: Arc<BiomeRules>,
+    generation: u64,
+    shutdown: bool,
+}
+
+struct Shared {
+    queue: Mutex<Queue>,
+    wake: Condvar,
+}
+
+impl Shared {
+    /// A poisoned lock only means a worker panicked while holding it; the queue is plain data
+    /// that is valid after any completed statement, so keep going.
+    fn lock(&self) -> MutexGuard<'_, Queue> {
+        self.queue.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// The worker pool and its queue.
+pub struct Workers {
+    shared: Arc<Shared>,
+    _threads: Vec<JoinHandle<()>>,
+}
+
+impl Workers {
+    /// Starts `threads` workers building chunks with `generator` and `rules`, sending results
+    /// to `done`.
+    pub fn start(
+        threads: usize,
+        generator: Arc<Generator>,
+        palette: Arc<BiomePalette>,
+        rules: Arc<BiomeRules>,
+        compression: CompressionThreshold,
+        done: Sender<Finished>,
+    ) -> std::io::Result<Workers> {
+        let shared = Arc::new(Shared {
+            queue: Mutex::new(Queue {
+                pending: Vec::new(),
+                in_flight: HashSet::new(),
+                rules,
+                generation: 0,
+                shutdown: false,
+            }),
+            wake: Condvar::new(),
+        });
+        let mut handles = Vec::with_capacity(threads);
+        for i in 0..threads.max(1) {
+            let (shared, generator, palette, done) = (shared.clone(), generator.clone(), palette.clone(), done.clone());
+            let handle = thread::Builder::new()
+                .name(format!("chunk-worker-{i}"))
+                .spawn(move || work(&shared, &generator, &palette, compression, &done))?;
+            handles.push(handle);
+        }
+        Ok(Workers { shared, _threads: handles })
+    }
+
+    /// Replaces the wish list (`nearest_first`: most urgent first). Chunks being built are
+    /// skipped; everything not listed is dropped.
+    pub fn set_wanted(&self, nearest_first: impl DoubleEndedIterator<Item = ChunkPos>) {
+        let mut q = self.shared.lock();
+        let in_flight = std::mem::take(&mut q.in_flight);
+        q.pending.clear();
+        q.pending.extend(nearest_first.rev().filter(|p| !in_flight.contains(p)));
+        q.in_flight = in_flight;
+        drop(q);
+        self.shared.wake.notify_all();
+    }
+
+    /// Marks a chunk as no longer being built (its result arrived).
+    pub fn finished(&self, pos: ChunkPos) {
+        self.shared.lock().in_flight.remove(&pos);
+    }
+
+    /// Chunks built from now on use `rules`; returns the new generation number.
+    pub fn set_rules(&self, rules: Arc<BiomeRules>) -> u64 {
+        let mut q = self.shared.lock();
+        q.rules = rules;
+        q.generation += 1;
+        q.generation
+    }
+
+    /// The current rules generation.
+    pub fn generation(&self) -> u64 {
+        self.shared.lock().generation
+    }
+
+    /// (waiting, in flight) job counts.
+    pub fn counts(&self) -> (usize, usize) {
+        let q = self.shared.lock();
+        (q.pending.len(), q.in_flight.len())
+    }
+}
+
+impl Drop for Workers {
+    /// Workers finish the chunk in hand and exit; nobody waits for them (the process is
+    /// ending or the pool is being replaced).
+    fn drop(&mut self) {
+        self.shared.lock().shutdown = true;
+        self.shared.wake.notify_all();
+    }
+}
+
+fn work(
+    shared: &Shared,
+    generator: &Generator,
+    palette: &BiomePalette,
+    compression: CompressionThreshold,
+    done: &Sender<Finished>,
+) {
+    loop {
+        let (pos, rules, generation) = {
+            let mut q = shared.lock();
+            loop {
+                if q.shutdown {
+                    return;
+                }
+                if let Some(pos) = q.pending.pop() {
+                    q.in_flight.insert(pos);
+                    break (pos, q.rules.clone(), q.generation);
+                }
+                q = shared.wake.wait(q).unwrap_or_else(PoisonError::into_inner);
+            }
+        };
+        let start = Instant::now();
+        // A panic in one chunk must not take the worker (and all later chunks) with it.
+        let built = catch_unwind(AssertUnwindSafe(|| build(generator, &rules, palette, compression, pos)))
+            .unwrap_or_else(|_| Err(anyhow::anyhow!("building it panicked (see above)")));
+        let built = built.map_err(|e| tracing::error!("chunk {} {}: {e:#}", pos.x, pos.z)).ok();
+        let finished = Finished { pos, built, generation, elapsed: start.elapsed() };
+        if done.send(finished).is_err() {
+            return; // The server is gone.
+        }
+    }
+}
+
+/// Builds one chunk and encodes its light packet the way valence encodes everything else.
+fn build(
+    generator: &Generator,
+    rules: &BiomeRules,
+    palette: &BiomePalette,
+    compression: CompressionThreshold,
+    pos: ChunkPos,
+) -> anyhow::Result<Built> {
+    let chunk = generator.chunk(rules, palette, pos.x, pos.z);
+    let mut encoder = PacketEncoder::new();
+    encoder.set_compression(compression);
+    encoder.append_packet(&SkyLight::of(&chunk).packet(pos))?;
+    Ok(Built { chunk, light: Arc::from(&encoder.take()[..]) })
+}
+
+/// The receiving end, wrapped so a Bevy resource (which must be `Sync`) can own it.
+pub struct Results(Mutex<Receiver<Finished>>);
+
+impl Results {
+    /// Wraps a receiver.
+    pub fn new(receiver: Receiver<Finished>) -> Results {
+        Results(Mutex::new(receiver))
+    }
+
+    /// Every result available now, without waiting.
+    pub fn drain(&self) -> Vec<Finished> {
+        let receiver = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        receiver.try_iter().collect()
+    }
+}

@@ -1,0 +1,73 @@
+//! The world's shape as the client sees it: the dimension (height, floor) and the biome
+//! registry, and the one chunk layer everyone plays in.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use valence::prelude::*;
+
+use crate::biome::BiomeRules;
+use crate::config::Config;
+use crate::fill::{vanilla_biome_names, BiomePalette, Generator};
+
+/// What start-up hands the app: configuration, generator and the biome rules.
+#[derive(Resource)]
+pub struct WorldSetup {
+    /// The validated configuration.
+    pub config: Config,
+    /// Builds chunks.
+    pub generator: Arc<Generator>,
+    /// The biome rules loaded at start-up.
+    pub rules: Arc<BiomeRules>,
+    /// Where `reload` reads rules from.
+    pub biomes_dir: PathBuf,
+}
+
+/// Biome names → client ids, fixed at start-up (every vanilla biome is registered, so any
+/// rule set a `reload` brings in maps too).
+#[derive(Resource, Clone)]
+pub struct Palette(pub Arc<BiomePalette>);
+
+/// Adds the start-up systems.
+pub fn build(app: &mut App) {
+    app.add_systems(Startup, (reshape_dimension, apply_deferred, create_layer).chain());
+}
+
+/// Refuses rules that name a biome the client does not know: it would silently become plains.
+pub fn check_biome_names(rules: &BiomeRules) -> anyhow::Result<()> {
+    let known = vanilla_biome_names();
+    let unknown: Vec<&str> = rules.biome_names().into_iter().filter(|n| !known.iter().any(|k| k == n)).collect();
+    if unknown.is_empty() {
+        Ok(())
+    } else {
+        anyhow::bail!(
+            "biome rules name biomes that Minecraft 1.20.1 does not have: {} (names look like \"minecraft:plains\")",
+            unknown.join(", ")
+        )
+    }
+}
+
+/// Players are in vanilla's overworld (clients know its sky and fog), reshaped to the
+/// configured height.
+fn reshape_dimension(setup: Res<WorldSetup>, mut dimensions: ResMut<DimensionTypeRegistry>) {
+    let w = &setup.config.world;
+    let Some(dim) = dimensions.get_mut(ident!("overworld")) else {
+        tracing::error!("the vanilla dimension minecraft:overworld is missing from valence's registry");
+        return;
+    };
+    // Validated at load: multiples of 16 inside the client's −2032..2031.
+    dim.min_y = w.min_y as i32;
+    dim.height = w.height as i32;
+    dim.logical_height = w.height as i32;
+}
+
+fn create_layer(
+    mut commands: Commands,
+    server: Res<Server>,
+    dimensions: Res<DimensionTypeRegistry>,
+    biomes: Res<BiomeRegistry>,
+) {
+    let palette = Arc::new(BiomePalette::from_registry(&biomes));
+    commands.insert_resource(Palette(palette));
+    commands.spawn(LayerBundle::new(ident!("overworld"), &dimensions, &biomes, &server));
+}

@@ -1,0 +1,156 @@
+//! Radially averaged power spectra and their log-log slope β.
+//!
+//! Convention: power ∝ k^β, with k the spatial frequency. White noise has β = 0; a field
+//! whose Fourier amplitudes fall as k⁻¹ (2-D "brown" noise) has β = −2; real 1 km DEMs sit
+//! near β ≈ −2.8…−3.1 (fBm with Hurst exponent H has β = −2 − 2H).
+
+use super::fft::{fft2, Complex};
+use super::Raster;
+
+/// A radially averaged power spectrum: ring ρ = 1…N/2 of an N×N periodogram.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spectrum {
+    /// Ring frequencies, cycles per metre (ρ / (N·pixel)).
+    pub frequency: Vec<f64>,
+    /// Mean power spectral density of the ring, m²·m² (windowed periodogram).
+    pub power: Vec<f64>,
+}
+
+impl Spectrum {
+    /// The mean of spectra over the same rings (tiles of one size and resolution); `None`
+    /// when there are none or their rings differ.
+    pub fn mean(spectra: &[Spectrum]) -> Option<Spectrum> {
+        let first = spectra.first()?;
+        if spectra.iter().any(|s| s.frequency != first.frequency) {
+            return None;
+        }
+        let n = spectra.len() as f64;
+        let power = (0..first.power.len()).map(|i| spectra.iter().map(|s| s.power[i]).sum::<f64>() / n).collect();
+        Some(Spectrum { frequency: first.frequency.clone(), power })
+    }
+}
+
+/// Plane `a + b·x + c·y` fitted by least squares on a regular grid (x and y are centred, so
+/// the normal equations are diagonal).
+fn detrended(values: &[f64], n: usize) -> Vec<f64> {
+    let centre = (n as f64 - 1.0) / 2.0;
+    let (mut sum, mut sx, mut sy, mut sxx) = (0.0, 0.0, 0.0, 0.0);
+    for (i, &v) in values.iter().enumerate() {
+        let (y, x) = ((i / n) as f64 - centre, (i % n) as f64 - centre);
+        sum += v;
+        sx += v * x;
+        sy += v * y;
+        sxx += x * x;
+    }
+    let (a, b, c) = (sum / values.len() as f64, sx / sxx, sy / sxx);
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| v - a - b * ((i % n) as f64 - centre) - c * ((i / n) as f64 - centre))
+        .collect()
+}
+
+/// The radially averaged power spectrum of the largest centred power-of-two square of `r`:
+/// a best-fit plane is removed and a 2-D Hann window applied (so the tile's edges do not
+/// leak a k⁻² artefact into every ring), then |FFT|²·pixel²/Σw² is averaged over integer
+/// rings ρ = round(|k|). Empty for rasters under 8×8.
+pub fn radial_power_spectrum(r: &Raster) -> Spectrum {
+    let side = r.rows.min(r.cols);
+    if side < 8 {
+        return Spectrum { frequency: Vec::new(), power: Vec::new() };
+    }
+    let n = 1usize << side.ilog2();
+    let crop = r.crop((r.rows - n) / 2, (r.cols - n) / 2, n, n);
+    let values: Vec<f64> = crop.data.iter().map(|&v| v as f64).collect();
+    let hann: Vec<f64> =
+        (0..n).map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / (n - 1) as f64).cos()).collect();
+    let mut field: Vec<Complex> =
+        detrended(&values, n).iter().enumerate().map(|(i, &v)| (v * hann[i / n] * hann[i % n], 0.0)).collect();
+    let weight: f64 = hann.iter().map(|w| w * w).sum::<f64>().powi(2);
+    fft2(&mut field, n, n, false);
+    let rings = n / 2;
+    let (mut sum, mut count) = (vec![0.0; rings + 1], vec![0usize; rings + 1]);
+    let signed = |i: usize| if i < n / 2 { i as f64 } else { i as f64 - n as f64 };
+    for (i, v) in field.iter().enumerate() {
+        let rho = signed(i / n).hypot(signed(i % n)).round() as usize;
+        if (1..=rings).contains(&rho) {
+            sum[rho] += (v.0 * v.0 + v.1 * v.1) * r.metres * r.metres / weight;
+            count[rho] += 1;
+        }
+    }
+    let frequency = (1..=rings).map(|rho| rho as f64 / (n as f64 * r.metres)).collect();
+    let power = (1..=rings).map(|rho| sum[rho] / count[rho].max(1) as f64).collect();
+    Spectrum { frequency, power }
+}
+
+/// The fitted slope β of log power against log frequency over rings 4…N/4 (wavelengths from
+/// a quarter of the tile down to 4 pixels: the lowest rings are blurred by the window, the
+/// highest by resampling and gridding). Rings are weighted 1/ρ so each octave counts the same.
+/// NaN when fewer than 3 usable rings.
+pub fn fit_beta(s: &Spectrum) -> f64 {
+    let rings = s.power.len();
+    let points: Vec<(f64, f64, f64)> = (4..=rings / 2)
+        .filter(|&rho| s.power[rho - 1] > 0.0)
+        .map(|rho| (s.frequency[rho - 1].ln(), s.power[rho - 1].ln(), 1.0 / rho as f64))
+        .collect();
+    if points.len() < 3 {
+        return f64::NAN;
+    }
+    let wsum: f64 = points.iter().map(|p| p.2).sum();
+    let mx = points.iter().map(|p| p.2 * p.0).sum::<f64>() / wsum;
+    let my = points.iter().map(|p| p.2 * p.1).sum::<f64>() / wsum;
+    let sxy: f64 = points.iter().map(|p| p.2 * (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| p.2 * (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::fbm::Gaussian;
+    use std::f64::consts::TAU;
+
+    #[test]
+    fn white_noise_has_a_flat_spectrum() {
+        let mut g = Gaussian::new(7);
+        let r = Raster::from_fn(128, 128, 1000.0, |_, _| (g.next() * 100.0) as f32);
+        let beta = fit_beta(&radial_power_spectrum(&r));
+        assert!(beta.abs() < 0.1, "white noise β = {beta}");
+    }
+
+    #[test]
+    fn amplitudes_falling_as_one_over_k_give_beta_minus_two() {
+        // Built by a naive inverse DFT (no FFT involved): every lattice frequency k ≠ 0 of the
+        // half plane with amplitude |k|⁻¹ and a random phase. Power ∝ |k|⁻², so β = −2.
+        let n = 64;
+        let mut g = Gaussian::new(11);
+        let mut waves = Vec::new();
+        for ky in 0..=n as i64 / 2 {
+            for kx in -(n as i64) / 2 + 1..=n as i64 / 2 {
+                if ky == 0 && kx <= 0 {
+                    continue;
+                }
+                let k = ((kx * kx + ky * ky) as f64).sqrt();
+                waves.push((kx as f64, ky as f64, g.next().hypot(g.next()) / k, TAU * g.uniform()));
+            }
+        }
+        let r = Raster::from_fn(n, n, 500.0, |y, x| {
+            waves
+                .iter()
+                .map(|&(kx, ky, a, p)| a * (TAU * (kx * x as f64 + ky * y as f64) / n as f64 + p).cos())
+                .sum::<f64>() as f32
+        });
+        let beta = fit_beta(&radial_power_spectrum(&r));
+        assert!((beta + 2.0).abs() < 0.2, "brown noise β = {beta}");
+    }
+
+    #[test]
+    fn rings_are_in_cycles_per_metre_and_odd_sizes_are_cropped() {
+        let r = Raster::from_fn(40, 70, 250.0, |y, x| (x + y) as f32);
+        let s = radial_power_spectrum(&r);
+        assert_eq!(s.frequency.len(), 16, "a 40×70 raster is measured on its central 32×32");
+        assert!((s.frequency[0] - 1.0 / (32.0 * 250.0)).abs() < 1e-15);
+        assert!(s.power.iter().all(|p| *p < 1e-12), "a plane is removed entirely: {:?}", s.power);
+        assert!(Spectrum::mean(&[s.clone(), s.clone()]).is_some_and(|m| m == s));
+    }
+}

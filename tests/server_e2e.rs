@@ -1,0 +1,345 @@
+//! End to end: a real `infiniterra serve` process, real Minecraft 1.20.1 clients (mineflayer,
+//! in `tests/e2e/`), and the same world computed in this process to compare with.
+//!
+//! Every wait is for a line or an exit, bounded by a timeout; nothing sleeps to synchronise.
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::TcpListener;
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
+
+use infiniterra::biome::BiomeRules;
+use infiniterra::config::Config;
+use infiniterra::fill::Generator;
+use infiniterra::server::find_spawn;
+use infiniterra::terrain::Pipeline;
+use serde_json::Value;
+use valence::prelude::{ChunkPos, ChunkView};
+
+/// Start-up includes building the pipeline and searching a spawn point in a debug build.
+const START_TIMEOUT: Duration = Duration::from_secs(180);
+const LINE_TIMEOUT: Duration = Duration::from_secs(30);
+/// View distance the test players ask for (and the server's cap).
+const VIEW: u8 = 4;
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Installs the node clients once per test binary if `scripts/test` has not already.
+fn node_clients() -> &'static Path {
+    static READY: OnceLock<PathBuf> = OnceLock::new();
+    READY.get_or_init(|| {
+        let dir = repo().join("tests/e2e");
+        if !dir.join("node_modules/mineflayer/package.json").is_file() {
+            let status = Command::new("npm")
+                .args(["ci", "--no-audit", "--no-fund", "--loglevel=error", "--prefix"])
+                .arg(&dir)
+                .status()
+                .expect("npm is needed for the end-to-end tests");
+            assert!(status.success(), "npm ci --prefix tests/e2e failed");
+        }
+        dir
+    })
+}
+
+/// A running server and its console.
+struct Server {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    lines: Receiver<String>,
+    stderr: Arc<Mutex<Vec<String>>>,
+    port: u16,
+    config: Config,
+    _dir: tempfile::TempDir,
+}
+
+impl Server {
+    /// Starts `infiniterra serve` on a free loopback port with rules from `biomes`, and waits
+    /// for "listening on".
+    fn start(biomes: &Path, seed: u64) -> Server {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let port = free_port();
+        let config_path = dir.path().join("server.toml");
+        let text = format!(
+            "[server]\nbind = \"127.0.0.1:{port}\"\nview_distance_cap = {VIEW}\nchunk_threads = 2\nchunk_cache = 512\n\n\
+             [world]\nseed = {seed}\n"
+        );
+        std::fs::write(&config_path, text).expect("write config");
+        let config = Config::load(&config_path).expect("test config loads");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
+            .arg("serve")
+            .arg("--config")
+            .arg(&config_path)
+            .arg("--biomes")
+            .arg(biomes)
+            .current_dir(repo())
+            .env("RUST_LOG", "info")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("start infiniterra serve");
+        let (tx, lines) = mpsc::channel();
+        let stdout = child.stdout.take().expect("stdout");
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let stderr = Arc::new(Mutex::new(Vec::new()));
+        let (sink, err) = (stderr.clone(), child.stderr.take().expect("stderr"));
+        std::thread::spawn(move || {
+            for line in BufReader::new(err).lines().map_while(Result::ok) {
+                sink.lock().unwrap_or_else(|e| e.into_inner()).push(line);
+            }
+        });
+        let stdin = child.stdin.take();
+        let mut server = Server { child, stdin, lines, stderr, port, config, _dir: dir };
+        server.expect_line(|l| l.contains("listening on"), START_TIMEOUT);
+        server
+    }
+
+    /// Waits for a stdout line matching `want`; panics with the server's logs on timeout.
+    fn expect_line(&mut self, want: impl Fn(&str) -> bool, timeout: Duration) -> String {
+        let deadline = Instant::now() + timeout;
+        let mut seen = Vec::new();
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) if want(&line) => return line,
+                Ok(line) => seen.push(line),
+                Err(RecvTimeoutError::Timeout) => self.fail(&format!("timed out; stdout so far: {seen:#?}")),
+                Err(RecvTimeoutError::Disconnected) => self.fail(&format!("server exited; stdout: {seen:#?}")),
+            }
+        }
+    }
+
+    /// Types a console command.
+    fn command(&mut self, command: &str) {
+        let stdin = self.stdin.as_mut().expect("stdin open");
+        writeln!(stdin, "{command}").expect("write to the console");
+        stdin.flush().expect("flush the console");
+    }
+
+    /// `stop`, then waits for the process to exit.
+    fn stop(mut self) -> ExitStatus {
+        self.command("stop");
+        let deadline = Instant::now() + LINE_TIMEOUT;
+        loop {
+            if let Some(status) = self.child.try_wait().expect("wait for the server") {
+                return status;
+            }
+            if Instant::now() > deadline {
+                self.fail("did not exit within 30 s of `stop`");
+            }
+            // Polling an exit status has no event to wait on; this only paces the poll.
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn fail(&mut self, why: &str) -> ! {
+        let _ = self.child.kill();
+        let log = self.stderr.lock().unwrap_or_else(|e| e.into_inner()).join("\n");
+        panic!("server: {why}\n--- server stderr ---\n{log}");
+    }
+
+    /// Runs `node tests/e2e/SCRIPT PORT ARGS…` and parses its JSON line.
+    fn node(&mut self, script: &str, args: &[String]) -> Value {
+        let dir = node_clients();
+        let out = Command::new("node").arg(dir.join(script)).arg(self.port.to_string()).args(args).output();
+        let out = out.expect("node is needed for the end-to-end tests");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let line = stdout.lines().rev().find(|l| l.starts_with('{')).unwrap_or("");
+        match serde_json::from_str::<Value>(line) {
+            Ok(v) => v,
+            Err(_) => self.fail(&format!(
+                "{script} printed no JSON (exit {:?})\nstdout: {stdout}\nstderr: {}",
+                out.status,
+                String::from_utf8_lossy(&out.stderr)
+            )),
+        }
+    }
+
+    /// A player joins and reports; panics unless it spawned.
+    fn probe(&mut self, name: &str, extra: &[String]) -> Value {
+        let mut args = vec!["--name".into(), name.into(), "--view".into(), VIEW.to_string()];
+        args.extend_from_slice(extra);
+        let report = self.node("probe.js", &args);
+        if report["ok"] != Value::Bool(true) {
+            self.fail(&format!("player {name} failed: {report}"));
+        }
+        report
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn free_port() -> u16 {
+    let listener = TcpListener::bind("127.0.0.1:0").expect("bind a free port");
+    listener.local_addr().expect("local address").port()
+}
+
+fn load_rules(dir: &Path) -> BiomeRules {
+    BiomeRules::load_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+}
+
+fn generator(config: &Config) -> Generator {
+    Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), config)
+}
+
+fn short(biome: &str) -> &str {
+    biome.strip_prefix("minecraft:").unwrap_or(biome)
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create dir");
+    for entry in std::fs::read_dir(from).expect("read biomes") {
+        let path = entry.expect("dir entry").path();
+        if path.is_file() {
+            std::fs::copy(&path, to.join(path.file_name().expect("file name"))).expect("copy");
+        }
+    }
+}
+
+#[test]
+fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
+    let biomes = repo().join("biomes");
+    let mut server = Server::start(&biomes, 1);
+    let rules = load_rules(&biomes);
+    let generator = generator(&server.config);
+    let v = *generator.vertical();
+    let spawn = find_spawn(&generator, &rules);
+
+    let mut columns = Vec::new();
+    for dz in (-21..=21).step_by(7) {
+        for dx in (-21..=21).step_by(7) {
+            columns.push((i64::from(spawn.block.x) + dx, i64::from(spawn.block.z) + dz));
+        }
+    }
+    let list = columns.iter().map(|(x, z)| format!("{x},{z}")).collect::<Vec<_>>().join(";");
+    let expected_chunks = ChunkView::new(ChunkPos::new(0, 0), VIEW).iter().count();
+    let report =
+        server.probe("surveyor", &["--columns".into(), list, "--expect-chunks".into(), expected_chunks.to_string()]);
+    println!(
+        "join: spawned after {} ms, all {expected_chunks} chunks of view distance {VIEW} after {} ms",
+        report["spawn_ms"], report["all_chunks_ms"]
+    );
+
+    // (a) spawned where the server said, landed on solid ground above the sea.
+    assert_eq!(report["spawn"]["x"].as_f64(), Some(spawn.feet.x), "{report}");
+    assert_eq!(report["spawn"]["z"].as_f64(), Some(spawn.feet.z), "{report}");
+    assert_eq!(report["spawn"]["y"].as_f64(), Some(spawn.feet.y), "{report}");
+    assert_eq!(report["game_mode"], "creative");
+    assert_eq!(report["min_y"].as_i64(), Some(i64::from(v.min_y)));
+    assert_eq!(report["height"].as_i64(), Some(i64::from(v.height)));
+    assert_eq!(report["on_ground"], true);
+    let below = report["below"].as_str().unwrap_or("");
+    assert!(!matches!(below, "water" | "air" | "ice" | "powder_snow" | "lava"), "landed on {below}");
+    assert_eq!(report["below_y"].as_i64(), Some(i64::from(spawn.block.y)), "{report}");
+    assert!(spawn.block.y >= v.sea_level_y, "spawn ground Y {} is below the sea", spawn.block.y);
+    // On the ground block (mud and the like are a little lower than a full block).
+    let feet = report["position"]["y"].as_f64().unwrap_or(f64::NAN);
+    let ground_top = f64::from(spawn.block.y) + 1.0;
+    assert!(feet > ground_top - 0.5 && feet <= ground_top, "feet at {feet}, ground block top at {ground_top}");
+
+    // (b) every sampled column is what the pipeline + vertical mapping + rules say.
+    let seen = report["columns"].as_array().expect("columns");
+    assert_eq!(seen.len(), columns.len());
+    let mut land = 0;
+    for (c, &(x, z)) in seen.iter().zip(&columns) {
+        let s = generator.surface(&rules, x, z);
+        let y = c["y"].as_i64().expect("y");
+        if s.y >= v.water_top_y() {
+            land += 1;
+            assert_eq!(y, i64::from(s.y), "top of column ({x}, {z}): {c}");
+            assert_eq!(c["block"], s.top, "ground block of ({x}, {z})");
+            assert_eq!(c["biome"], short(&s.biome), "biome at ({x}, {}, {z})", s.y);
+        } else {
+            assert_eq!(y, i64::from(v.water_top_y()), "sea surface at ({x}, {z}): {c}");
+            assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
+        }
+    }
+    assert!(land > 0, "no land column sampled around the spawn");
+
+    server.expect_line(|l| l == "surveyor left", LINE_TIMEOUT);
+    server.command("status");
+    let players = server.expect_line(|l| l.starts_with("players:"), LINE_TIMEOUT);
+    assert!(players.starts_with("players: 0"), "{players}");
+    server.expect_line(|l| l.starts_with("chunks:") && l.contains("generated/s"), LINE_TIMEOUT);
+    server.expect_line(|l| l.starts_with("queue:") && l.contains("cached"), LINE_TIMEOUT);
+    server.expect_line(|l| l.starts_with("memory:") && l.contains("MiB"), LINE_TIMEOUT);
+    server.command("seed");
+    server.expect_line(|l| l == "seed 1", LINE_TIMEOUT);
+    server.command("frobnicate");
+    server.expect_line(|l| l.contains("unknown command") && l.contains("help"), LINE_TIMEOUT);
+    assert!(server.stop().success());
+}
+
+#[test]
+fn garbage_and_wrong_versions_are_refused_and_players_still_join() {
+    let mut server = Server::start(&repo().join("biomes"), 2);
+    let report = server.node("garbage.js", &[]);
+    for probe in ["varint_overflow", "http_request", "random_bytes"] {
+        assert_eq!(report[probe]["closed"], true, "{probe}: {report}");
+    }
+    assert_eq!(report["wrong_version"]["kicked"], true, "{report}");
+    assert_eq!(report["wrong_version"]["reached_play"], false, "{report}");
+    assert!(report["wrong_version"]["reason"].to_string().contains("1.20.1"), "{report}");
+
+    let player = server.probe("after_garbage", &[]);
+    assert_eq!(player["on_ground"], true);
+    // A second player after the first left: the server survived a disconnect too.
+    server.probe("second", &[]);
+    assert!(server.stop().success());
+}
+
+#[test]
+fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let biomes = dir.path().join("biomes");
+    copy_dir(&repo().join("biomes"), &biomes);
+    let mut server = Server::start(&biomes, 3);
+    let generator = generator(&server.config);
+    let rules = load_rules(&biomes);
+    let spawn = find_spawn(&generator, &rules);
+    let (x, z) = (i64::from(spawn.block.x), i64::from(spawn.block.z));
+    let column = vec!["--columns".to_string(), format!("{x},{z}")];
+    let before = generator.surface(&rules, x, z);
+    assert_ne!(before.biome, "minecraft:desert", "pick a seed whose spawn is not already desert");
+
+    let report = server.probe("first", &column);
+    assert_eq!(report["columns"][0]["biome"], short(&before.biome));
+
+    // A broken file: the old rules stay, and say why.
+    std::fs::write(biomes.join("zz_broken.toml"), "[[rule]]\nname = \"oops\"\nbiome = \n").expect("write");
+    server.command("reload");
+    let failed = server.expect_line(|l| l.starts_with("reload"), LINE_TIMEOUT);
+    assert!(failed.contains("failed") && failed.contains("zz_broken.toml"), "{failed}");
+    let report = server.probe("second", &column);
+    assert_eq!(report["columns"][0]["biome"], short(&before.biome));
+    // Chunks on screen keep the rules they were built with: let them go first.
+    server.expect_line(|l| l == "second left", LINE_TIMEOUT);
+
+    // Good rules that make everything desert: new chunks follow them.
+    for entry in std::fs::read_dir(&biomes).expect("read") {
+        std::fs::remove_file(entry.expect("entry").path()).expect("remove");
+    }
+    std::fs::write(biomes.join("all.toml"), "fallback = \"minecraft:desert\"\n").expect("write");
+    server.command("reload");
+    let reloaded = server.expect_line(|l| l.starts_with("reload"), LINE_TIMEOUT);
+    assert!(reloaded.starts_with("reloaded"), "{reloaded}");
+    let report = server.probe("third", &column);
+    assert_eq!(report["columns"][0]["biome"], "desert", "{report}");
+    assert!(server.stop().success());
+}
