@@ -253,7 +253,8 @@ fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
     let ground_top = f64::from(spawn.block.y) + 1.0;
     assert!(feet > ground_top - 0.5 && feet <= ground_top, "feet at {feet}, ground block top at {ground_top}");
 
-    // (b) every sampled column is what the pipeline + vertical mapping + rules say.
+    // (b) every sampled column is what the pipeline + vertical mapping + rules say (the
+    // ground under any tree).
     let seen = report["columns"].as_array().expect("columns");
     assert_eq!(seen.len(), columns.len());
     let mut land = 0;
@@ -265,9 +266,18 @@ fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
             assert_eq!(y, i64::from(s.y), "top of column ({x}, {z}): {c}");
             assert_eq!(c["block"], s.top, "ground block of ({x}, {z})");
             assert_eq!(c["biome"], short(&s.biome), "biome at ({x}, {}, {z})", s.y);
+            // Sky light: open sky above the ground (unless a tree shades it), dark inside it.
+            if c["covered"] == false {
+                assert_eq!(c["sky_light_above"], 15, "{c}");
+            }
+            assert_eq!(c["sky_light_at"], 0, "{c}");
         } else {
             assert_eq!(y, i64::from(v.water_top_y()), "sea surface at ({x}, {z}): {c}");
             assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
+            // One level less per block of water or ice.
+            assert_eq!(c["sky_light_above"], 15, "{c}");
+            assert_eq!(c["sky_light_at"], 14, "{c}");
+            assert_eq!(c["sky_light_below"], 13, "{c}");
         }
     }
     assert!(land > 0, "no land column sampled around the spawn");
@@ -342,4 +352,38 @@ fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
     let report = server.probe("third", &column);
     assert_eq!(report["columns"][0]["biome"], "desert", "{report}");
     assert!(server.stop().success());
+}
+
+#[test]
+fn start_up_problems_exit_with_a_message_and_the_documented_code() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let run = |bind: &str, biomes: &Path| {
+        let config = dir.path().join("server.toml");
+        std::fs::write(&config, format!("[server]\nbind = \"{bind}\"\n")).expect("write config");
+        let out = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
+            .arg("serve")
+            .arg("--config")
+            .arg(&config)
+            .arg("--biomes")
+            .arg(biomes)
+            .stdin(Stdio::null())
+            .output()
+            .expect("run infiniterra serve");
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let biomes = repo().join("biomes");
+
+    let (code, stderr) = run("127.0.0.1:25565", &dir.path().join("no-such-dir"));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("no-such-dir"), "{stderr}");
+
+    let (code, stderr) = run("127.0.0.1:0", &biomes);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("port 0"), "{stderr}");
+
+    let taken = TcpListener::bind("127.0.0.1:0").expect("bind");
+    let address = taken.local_addr().expect("address").to_string();
+    let (code, stderr) = run(&address, &biomes);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("cannot listen on") && stderr.contains(&address), "{stderr}");
 }

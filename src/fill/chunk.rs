@@ -9,6 +9,7 @@ use crate::terrain::Rect;
 use super::cells::{self, CELL};
 use super::columns::Columns;
 use super::surface::{self, Ground, Site};
+use super::trees::{self, Tree};
 use super::{BiomePalette, Generator, SurfaceSample};
 
 /// Blocks per chunk edge.
@@ -23,8 +24,14 @@ impl Generator {
     /// meet without seams (everything is a function of global coordinates).
     pub fn chunk(&self, rules: &BiomeRules, palette: &BiomePalette, chunk_x: i32, chunk_z: i32) -> UnloadedChunk {
         let (x0, z0) = (i64::from(chunk_x) * CHUNK, i64::from(chunk_z) * CHUNK);
-        // One column of border on every side, for slopes and steepness at the edges.
-        let columns = Columns::query(&self.pipeline, &self.vertical, Rect::new(z0 - 1, x0 - 1, CHUNK + 2, CHUNK + 2));
+        // Trees rooted up to `REACH` outside the chunk, plus one column of border for slopes
+        // and steepness at the edges.
+        let pad = trees::REACH + 1;
+        let columns = Columns::query(
+            &self.pipeline,
+            &self.vertical,
+            Rect::new(z0 - pad, x0 - pad, CHUNK + 2 * pad, CHUNK + 2 * pad),
+        );
         let v = &self.vertical;
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
 
@@ -77,7 +84,49 @@ impl Generator {
                 }
             }
         }
+        let trees = self.trees(rules, &columns, x0, z0, CHUNK);
+        trees::place(&mut chunk, &trees, x0, z0, v.min_y);
         chunk
+    }
+
+    /// True when no tree stands on or over column (`x`, `z`) (a place to put a player).
+    pub fn clear_of_trees(&self, rules: &BiomeRules, x: i64, z: i64) -> bool {
+        let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
+        self.trees(rules, &columns, x, z, 1)
+            .iter()
+            .all(|t| (t.x - x).abs() >= trees::REACH || (t.z - z).abs() >= trees::REACH)
+    }
+
+    /// Every tree rooted within reach of the `size`×`size` square at (`x0`, `z0`), in global
+    /// order. `columns` must cover [`tree_rect`] of the square.
+    fn trees(&self, rules: &BiomeRules, columns: &Columns, x0: i64, z0: i64, size: i64) -> Vec<Tree> {
+        debug_assert!(columns.rect().contains_rect(&tree_rect(x0, z0, size)));
+        let v = &self.vertical;
+        let mut trees = Vec::new();
+        for (x, z, chance) in trees::candidate_roots(self.seed, x0, z0, size) {
+            let biome = self.surface_biome(rules, columns, x, z);
+            let Some((density, kind)) = trees::woodland(biome) else { continue };
+            if chance >= density {
+                continue;
+            }
+            let ground_y = columns.surface_y(x, z);
+            let ground = self.ground_at(columns, biome, x, z);
+            let dry = ground_y >= v.water_top_y() && !ground.top.is_liquid();
+            if dry && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top) {
+                let tree = Tree::new(self.seed, x, z, ground_y, kind);
+                if tree.top_y() < v.min_y + v.height {
+                    trees.push(tree);
+                }
+            }
+        }
+        trees
+    }
+
+    /// Biome of the cell holding the ground block of column (`x`, `z`).
+    fn surface_biome<'r>(&self, rules: &'r BiomeRules, columns: &Columns, x: i64, z: i64) -> &'r str {
+        let (sx, sz) = cells::sample_column(x.div_euclid(CELL), z.div_euclid(CELL));
+        let centre = cells::cell_centre_y(columns.surface_y(x, z));
+        rules.biome(&cells::conditions(columns, &self.vertical, self.lapse_c_per_km, sx, sz, centre))
     }
 
     /// The topmost ground block of column (`x`, `z`) and the biome of the cell holding it,
@@ -91,12 +140,9 @@ impl Generator {
             Rect::new(cell_z * CELL - 1, cell_x * CELL - 1, CELL + 2, CELL + 2),
         );
         let y = columns.surface_y(x, z);
-        let (sx, sz) = cells::sample_column(cell_x, cell_z);
-        let conditions =
-            cells::conditions(&columns, &self.vertical, self.lapse_c_per_km, sx, sz, cells::cell_centre_y(y));
-        let biome = rules.biome(&conditions).to_string();
-        let top = self.ground_at(&columns, &biome, x, z).top;
-        SurfaceSample { y, biome, top: top.to_kind().to_str() }
+        let biome = self.surface_biome(rules, &columns, x, z);
+        let top = self.ground_at(&columns, biome, x, z).top;
+        SurfaceSample { y, biome: biome.to_string(), top: top.to_kind().to_str() }
     }
 
     /// Biome names of every cell of a chunk, indexed `(cell_z·4 + cell_x)·cells_y + cell_y`.
@@ -170,11 +216,43 @@ impl Generator {
     }
 }
 
+/// The columns needed to decide the trees around the `size`×`size` square at (`x0`, `z0`)
+/// (and so everything else in it): roots up to `REACH` outside it with one neighbour each
+/// for steepness, and the sample columns (with neighbours) of the biome cells holding them.
+fn tree_rect(x0: i64, z0: i64, size: i64) -> Rect {
+    let span = |lo: i64| {
+        let (first_root, last_root) = (lo - trees::REACH, lo + size - 1 + trees::REACH);
+        let first_sample = cells::sample_column(first_root.div_euclid(CELL), 0).0;
+        let last_sample = cells::sample_column(last_root.div_euclid(CELL), 0).0;
+        let start = (first_root - 1).min(first_sample - 1);
+        (start, (last_root + 1).max(last_sample + 1) - start + 1)
+    };
+    let ((x, w), (z, h)) = (span(x0), span(z0));
+    Rect::new(z, x, h, w)
+}
+
 /// Deepslate below Y 0, stone above (as in vanilla).
 fn rock(y: i32) -> BlockState {
     if y < 0 {
         BlockState::DEEPSLATE
     } else {
         BlockState::STONE
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_chunk_needs_four_columns_of_border_and_any_square_its_cells() {
+        assert_eq!(tree_rect(0, 16, 16), Rect::new(12, -4, 24, 24));
+        for x in -9..9 {
+            let r = tree_rect(x, x, 1);
+            // The cell of the farthest root on each side, with its sample column's neighbours.
+            let lo_cell = (x - trees::REACH).div_euclid(CELL) * CELL;
+            assert!(r.x0 <= lo_cell + 1 && r.x0 < x - trees::REACH, "{x}: {r:?}");
+            assert!(r.x1() > x + trees::REACH + 1, "{x}: {r:?}");
+        }
     }
 }

@@ -12,6 +12,7 @@ mod columns;
 mod hash;
 mod light;
 mod surface;
+mod trees;
 mod vertical;
 
 use std::collections::HashMap;

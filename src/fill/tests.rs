@@ -54,12 +54,17 @@ fn generator(seed: u64) -> Generator {
     Generator::new(Arc::new(Pipeline::new(seed, &config.terrain())), &config)
 }
 
-/// Highest non-air block of a chunk column: (world Y, block).
+fn is_tree(b: BlockState) -> bool {
+    let name = b.to_kind().to_str();
+    name.ends_with("_log") || name.ends_with("_leaves")
+}
+
+/// Highest ground block of a chunk column (not air, not tree): (world Y, block).
 fn top(chunk: &UnloadedChunk, v: &Vertical, lx: u32, lz: u32) -> (i32, BlockState) {
     (0..chunk.height())
         .rev()
         .map(|y| (y, chunk.block_state(lx, y, lz)))
-        .find(|(_, b)| !b.is_air())
+        .find(|(_, b)| !b.is_air() && !is_tree(*b))
         .map_or((v.min_y, BlockState::AIR), |(y, b)| (y as i32 + v.min_y, b))
 }
 
@@ -160,4 +165,35 @@ fn the_sea_is_water_up_to_the_water_top_and_frozen_where_cold() {
     let surface = chunk.block_state(8, (v.water_top_y() - v.min_y) as u32, 8);
     assert!(matches!(surface, BlockState::WATER | BlockState::ICE));
     assert_eq!(chunk.block_state(8, (v.sea_level_y - v.min_y) as u32, 8), BlockState::AIR);
+}
+
+#[test]
+fn woodland_grows_trees_that_stand_on_the_ground() {
+    let forest = "fallback = \"minecraft:forest\"\n";
+    let rules = BiomeRules::from_sources(&[(PathBuf::from("forest.toml"), forest.to_string())]).expect("forest rules");
+    let (g, palette) = (generator(4), palette());
+    let v = *g.vertical();
+    // Land chunks near the origin (this seed's origin may be sea).
+    let land: Vec<(i32, i32)> = (-30..30)
+        .flat_map(|cz| (-30..30).map(move |cx| (cx, cz)))
+        .filter(|&(cx, cz)| g.surface(&rules, i64::from(cx) * 16 + 8, i64::from(cz) * 16 + 8).y > v.sea_level_y + 2)
+        .take(8)
+        .collect();
+    assert_eq!(land.len(), 8, "no land near the origin for seed 4");
+    let mut trunks = 0;
+    for &(cx, cz) in &land {
+        let chunk = g.chunk(&rules, &palette, cx, cz);
+        for lz in 0..16u32 {
+            for lx in 0..16u32 {
+                let (ground_y, ground) = top(&chunk, &v, lx, lz);
+                let above = chunk.block_state(lx, (ground_y + 1 - v.min_y) as u32, lz);
+                if above == BlockState::OAK_LOG {
+                    trunks += 1;
+                    assert_eq!(ground, BlockState::GRASS_BLOCK, "a trunk on {ground:?}");
+                }
+            }
+        }
+    }
+    // 70 % of the 5×5 cells of 8 land chunks: about 50 trees, fewer on steep or wet ground.
+    assert!(trunks >= 10, "only {trunks} trees in 8 forest chunks");
 }

@@ -23,7 +23,7 @@ use crate::config::Config;
 use crate::fill::Generator;
 use crate::terrain::Pipeline;
 
-pub use spawn::find_spawn;
+pub use spawn::{find_spawn, SpawnPoint};
 
 /// Options of `infiniterra serve` beyond the configuration file.
 #[derive(Clone, Debug)]
@@ -50,6 +50,11 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
     world::check_biome_names(&rules).map_err(ServeError::Input)?;
 
     let address = config.bind_address();
+    if address.port() == 0 {
+        return Err(ServeError::Input(anyhow::anyhow!(
+            "server.bind = \"{address}\": port 0 would pick a random port players cannot know; set one, e.g. 25565"
+        )));
+    }
     check_address_free(address).map_err(ServeError::Runtime)?;
     if !config.server.online_mode {
         eprintln!(

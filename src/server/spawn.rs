@@ -67,7 +67,7 @@ fn walkable_column(generator: &Generator, rules: &BiomeRules, x0: i64, z0: i64, 
     candidates.into_iter().take(CHUNK as usize).find_map(|(x, z)| {
         let surface = generator.surface(rules, x, z);
         let solid = !matches!(surface.top, "powder_snow" | "water" | "ice");
-        solid.then(|| at(x, surface.y, z))
+        (solid && generator.clear_of_trees(rules, x, z)).then(|| at(x, surface.y, z))
     })
 }
 

@@ -59,6 +59,9 @@ fn reshape_dimension(setup: Res<WorldSetup>, mut dimensions: ResMut<DimensionTyp
     dim.min_y = w.min_y as i32;
     dim.height = w.height as i32;
     dim.logical_height = w.height as i32;
+    // valence forces full-bright ambient light because it sends no light; the server sends
+    // sky light itself (see `fill::SkyLight`), so the night and the deep sea can be dark.
+    dim.ambient_light = 0.0;
 }
 
 fn create_layer(

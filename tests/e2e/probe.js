@@ -48,6 +48,7 @@ function main () {
   })
   const report = { ok: false, name: args.name }
   const chunks = new Set()
+  const lit = new Map() // chunk → its latest light packet (the server sends it after the chunk)
   let done = false
   const fail = (error) => {
     if (done) return
@@ -68,6 +69,8 @@ function main () {
     }
   })
 
+  bot._client.on('update_light', packet => lit.set(`${packet.chunkX},${packet.chunkZ}`, packet))
+
   bot.once('spawn', () => {
     report.spawn_ms = Date.now() - started
     report.spawn = vec(bot.entity.position)
@@ -85,7 +88,8 @@ function main () {
     if (args.expectChunks > 0 && chunks.size < args.expectChunks) return
     const columns = []
     for (const [x, z] of args.columns) {
-      const column = topOf(bot, x, z)
+      if (!lit.has(`${Math.floor(x / 16)},${Math.floor(z / 16)}`)) return
+      const column = topOf(bot, x, z, lit)
       if (column === null) return // not loaded yet
       columns.push(column)
     }
@@ -97,6 +101,7 @@ function main () {
       below: below.name,
       below_y: below.position.y,
       chunks: chunks.size,
+      lit_chunks: lit.size,
       columns
     })
     finish(bot, 0, report)
@@ -104,18 +109,54 @@ function main () {
   bot.on('physicsTick', check)
 }
 
-// The highest non-air block of column (x, z), its biome, or null when not loaded.
-function topOf (bot, x, z) {
+// The ground of column (x, z): its highest block that is neither air nor part of a tree, with
+// its biome and sky light, and whether anything (a tree) stands above it; null when the
+// column is not loaded yet.
+function topOf (bot, x, z, lit) {
   const minY = bot.game.minY
+  let covered = false
   for (let y = minY + bot.game.height - 1; y >= minY; y--) {
     const block = bot.blockAt(new Vec3(x, y, z))
     if (block === null) return null
-    if (block.name !== 'air' && block.name !== 'cave_air' && block.name !== 'void_air') {
-      const biome = bot.registry.biomes[block.biome.id]
-      return { x, z, y, block: block.name, biome: biome ? biome.name : `#${block.biome.id}` }
+    if (block.name === 'air' || block.name === 'cave_air' || block.name === 'void_air') continue
+    if (block.name.endsWith('_log') || block.name.endsWith('_leaves')) {
+      covered = true
+      continue
+    }
+    const biome = bot.registry.biomes[block.biome.id]
+    return {
+      x,
+      z,
+      y,
+      block: block.name,
+      biome: biome ? biome.name : `#${block.biome.id}`,
+      covered,
+      sky_light_above: skyLight(bot, lit, x, y + 1, z),
+      sky_light_at: skyLight(bot, lit, x, y, z),
+      sky_light_below: skyLight(bot, lit, x, y - 1, z)
     }
   }
-  return { x, z, y: minY - 1, block: 'air', biome: '' }
+  return { x, z, y: minY - 1, block: 'air', biome: '', covered }
+}
+
+// Sky light at a block as the vanilla client reads the last light packet of its chunk: one
+// 2048-byte array per section whose mask bit is set (bit 0 = the section below the world),
+// value i in byte i >> 1, low nibble first. (prismarine-chunk decodes these arrays as
+// big-endian longs, which mirrors x inside every 16 values, so it is not used here.)
+function skyLight (bot, lit, x, y, z) {
+  const packet = lit.get(`${Math.floor(x / 16)},${Math.floor(z / 16)}`)
+  const section = ((y - bot.game.minY) >> 4) + 1
+  const bit = (mask, i) => {
+    const long = mask[Math.floor(i / 64)]
+    if (!long) return 0
+    const [hi, lo] = long
+    return i % 64 < 32 ? (lo >>> (i % 64)) & 1 : (hi >>> (i % 64 - 32)) & 1
+  }
+  if (!bit(packet.skyLightMask, section)) return bit(packet.emptySkyLightMask, section) ? 0 : null
+  let array = 0
+  for (let i = 0; i < section; i++) array += bit(packet.skyLightMask, i)
+  const index = (((y - bot.game.minY) & 15) << 8) | ((z & 15) << 4) | (x & 15)
+  return (packet.skyLight[array][index >> 1] >> ((index & 1) * 4)) & 15
 }
 
 function vec (v) {

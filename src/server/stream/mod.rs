@@ -13,10 +13,12 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use valence::app::AppExit;
+use valence::client::{FlushPacketsSet, UpdateClientsSet};
 use valence::prelude::*;
+use valence::protocol::WritePacket;
 
 use self::cache::ChunkCache;
-use self::workers::{Finished, Results, Workers};
+use self::workers::{Built, Finished, Results, Workers};
 use super::players::PlayersSet;
 use super::world::{Palette, WorldSetup};
 use crate::biome::BiomeRules;
@@ -32,13 +34,23 @@ pub struct Streamer {
     cache: ChunkCache,
     /// Chunks whose building panicked: not retried until the rules change.
     failed: HashSet<ChunkPos>,
-    /// Rules generation each loaded chunk was built with (only current ones are cached).
-    loaded: HashMap<ChunkPos, u64>,
+    /// Every loaded chunk: the rules generation it was built with (only current ones are
+    /// cached when unloaded) and its light packet.
+    loaded: HashMap<ChunkPos, Loaded>,
     last_views: Vec<ChunkView>,
     /// Something changed that may change the wish list.
     dirty: bool,
     stats: Stats,
 }
+
+struct Loaded {
+    generation: u64,
+    light: Arc<[u8]>,
+}
+
+/// Chunks whose light this client has been sent (valence sends chunks without light).
+#[derive(Component, Default)]
+pub struct LightSent(HashSet<ChunkPos>);
 
 /// Counters for the console's `status`.
 #[derive(Default)]
@@ -107,18 +119,23 @@ impl Streamer {
 
 /// Adds the streaming systems.
 pub fn build(app: &mut App) {
-    app.add_systems(PostStartup, start_workers).add_systems(Update, stream_chunks.after(PlayersSet));
+    app.add_systems(PostStartup, start_workers)
+        .add_systems(Update, (track_light, stream_chunks.after(PlayersSet)))
+        // After valence has written this tick's chunk packets, before they are flushed.
+        .add_systems(PostUpdate, send_light.after(UpdateClientsSet).before(FlushPacketsSet));
 }
 
 fn start_workers(
     mut commands: Commands,
     setup: Res<WorldSetup>,
     palette: Res<Palette>,
+    server: Res<Server>,
     mut exit: EventWriter<AppExit>,
 ) {
     let (done, results) = mpsc::channel();
     let threads = setup.config.server.chunk_threads as usize;
-    match Workers::start(threads, setup.generator.clone(), palette.0.clone(), setup.rules.clone(), done) {
+    let (generator, palette, rules) = (setup.generator.clone(), palette.0.clone(), setup.rules.clone());
+    match Workers::start(threads, generator, palette, rules, server.compression_threshold(), done) {
         Ok(workers) => commands.insert_resource(Streamer {
             workers,
             results: Results::new(results),
@@ -151,23 +168,22 @@ fn stream_chunks(
     let wanted = |pos: ChunkPos| views.iter().any(|v| v.contains(pos));
     let generation = s.workers.generation();
 
-    for Finished { pos, chunk, generation: built_with, elapsed } in s.results.drain() {
+    for Finished { pos, built, generation: built_with, elapsed } in s.results.drain() {
         s.workers.finished(pos);
         s.dirty = true;
-        let Some(chunk) = chunk else {
+        let Some(built) = built else {
             s.stats.failed += 1;
             s.failed.insert(pos);
-            tracing::error!("building chunk {} {} failed (see the panic above); it stays empty", pos.x, pos.z);
-            continue;
+            continue; // The worker logged why; the chunk stays missing until a reload.
         };
         s.stats.generated += 1;
         s.stats.build_time += elapsed;
         s.stats.recent.push_back(Instant::now());
         if wanted(pos) && layer.chunk(pos).is_none() {
-            layer.insert_chunk(pos, chunk);
-            s.loaded.insert(pos, built_with);
+            layer.insert_chunk(pos, built.chunk);
+            s.loaded.insert(pos, Loaded { generation: built_with, light: built.light });
         } else if built_with == generation {
-            s.cache.put(pos, chunk);
+            s.cache.put(pos, built);
         }
     }
     s.trim_recent();
@@ -176,10 +192,10 @@ fn stream_chunks(
         s.dirty = true;
         let gone: Vec<ChunkPos> = layer.chunks().map(|(pos, _)| pos).filter(|&pos| !wanted(pos)).collect();
         for pos in gone {
-            let built_with = s.loaded.remove(&pos);
-            if let Some(chunk) = layer.remove_chunk(pos) {
-                if built_with == Some(generation) {
-                    s.cache.put(pos, chunk);
+            let loaded = s.loaded.remove(&pos);
+            if let (Some(chunk), Some(loaded)) = (layer.remove_chunk(pos), loaded) {
+                if loaded.generation == generation {
+                    s.cache.put(pos, Built { chunk, light: loaded.light });
                 }
             }
         }
@@ -194,9 +210,9 @@ fn stream_chunks(
                 if layer.chunk(pos).is_some() || s.failed.contains(&pos) {
                     continue;
                 }
-                if let Some(chunk) = s.cache.take(pos) {
-                    layer.insert_chunk(pos, chunk);
-                    s.loaded.insert(pos, generation);
+                if let Some(built) = s.cache.take(pos) {
+                    layer.insert_chunk(pos, built.chunk);
+                    s.loaded.insert(pos, Loaded { generation, light: built.light });
                     continue;
                 }
                 let d = view.pos.distance_squared(pos);
@@ -206,5 +222,32 @@ fn stream_chunks(
         let mut list: Vec<(u64, ChunkPos)> = nearest.into_iter().map(|(pos, d)| (d, pos)).collect();
         list.sort_unstable_by_key(|&(d, pos)| (d, pos.x, pos.z));
         s.workers.set_wanted(list.into_iter().map(|(_, pos)| pos));
+    }
+}
+
+fn track_light(mut commands: Commands, joined: Query<Entity, Added<Client>>) {
+    for entity in &joined {
+        commands.entity(entity).insert(LightSent::default());
+    }
+}
+
+/// Every loaded chunk in a client's view has been sent to it by now (valence does that in
+/// `UpdateClientsSet`); follow each one it has not had light for with its light packet.
+fn send_light(mut clients: Query<(&mut Client, View, &mut LightSent)>, streamer: Option<Res<Streamer>>) {
+    let Some(streamer) = streamer else {
+        return;
+    };
+    for (mut client, view, mut sent) in &mut clients {
+        let view = view.get();
+        // Chunks that left the view are forgotten by the client; resend if they come back.
+        sent.0.retain(|&pos| view.contains(pos));
+        for pos in view.iter() {
+            if !sent.0.contains(&pos) {
+                if let Some(loaded) = streamer.loaded.get(&pos) {
+                    client.write_packet_bytes(&loaded.light);
+                    sent.0.insert(pos);
+                }
+            }
+        }
     }
 }
