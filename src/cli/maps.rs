@@ -11,9 +11,9 @@ use crate::export::{self, ExportRequest, Grid, Vertical};
 use crate::render::{self, Layer, RenderRequest};
 use crate::terrain::Pipeline;
 
-/// Arguments of `infiniterra render`.
+/// A rectangle of the world in block coordinates (x east, z south).
 #[derive(Debug, Args)]
-pub struct RenderArgs {
+pub struct AreaArgs {
     /// West edge, block x.
     #[arg(long, allow_hyphen_values = true)]
     pub x0: i64,
@@ -23,6 +23,14 @@ pub struct RenderArgs {
     /// Size in blocks: `W` or `WxH`.
     #[arg(long)]
     pub size: Size,
+}
+
+/// Arguments of `infiniterra render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The rectangle of the world.
+    #[command(flatten)]
+    pub area: AreaArgs,
     /// Blocks per image pixel.
     #[arg(long, default_value_t = 1)]
     pub zoom: i64,
@@ -37,15 +45,9 @@ pub struct RenderArgs {
 /// Arguments of `infiniterra export`.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
-    /// West edge, block x.
-    #[arg(long, allow_hyphen_values = true)]
-    pub x0: i64,
-    /// North edge, block z.
-    #[arg(long, allow_hyphen_values = true)]
-    pub z0: i64,
-    /// Size in blocks: `W` or `WxH`.
-    #[arg(long)]
-    pub size: Size,
+    /// The rectangle of the world.
+    #[command(flatten)]
+    pub area: AreaArgs,
     /// `block`: one value per block column; `model`: one per model pixel (4×4 blocks).
     #[arg(long, default_value = "block")]
     pub grid: Grid,
@@ -72,7 +74,7 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
     if a.zoom < 1 {
         return Err(Failure::input(anyhow::anyhow!("--zoom {} is out of range (allowed 1 or more)", a.zoom)));
     }
-    let req = RenderRequest { x0: a.x0, z0: a.z0, width: a.size.width, height: a.size.height, zoom: a.zoom, layer: a.layer };
+    let req = RenderRequest { x0: a.area.x0, z0: a.area.z0, width: a.area.size.width, height: a.area.size.height, zoom: a.zoom, layer: a.layer };
     let pipeline = pipeline(config);
     let mut progress = Progress::new("render", "rows");
     let image = render::render(&pipeline, &req, &mut |d, t| progress.update(d, t)).map_err(|e| classify(e.is_bad_input(), e))?;
@@ -84,7 +86,7 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
 
 /// Runs `export`.
 pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
-    let req = ExportRequest { x0: a.x0, z0: a.z0, width: a.size.width, height: a.size.height, grid: a.grid };
+    let req = ExportRequest { x0: a.area.x0, z0: a.area.z0, width: a.area.size.width, height: a.area.size.height, grid: a.grid };
     let vertical = Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
     let pipeline = pipeline(config);
     let mut progress = Progress::new("export", "rows");

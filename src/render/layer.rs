@@ -21,7 +21,7 @@ pub enum Layer {
     Seasonality,
     /// Precipitation variability (coefficient of variation), %.
     Variability,
-    /// Minecraft biomes (needs the biome rules of issue #5).
+    /// Minecraft biomes (not drawn yet: open work of issue #5).
     Biome,
 }
 

@@ -50,7 +50,7 @@ pub struct RenderRequest {
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// The biome layer is requested before biome rules exist.
-    #[error("the biome layer needs biome rules, which arrive with issue #5")]
+    #[error("biome maps are not drawn yet (open work of issue #5); the server applies the biome rules in game")]
     BiomeNeedsRules,
     /// Zoom below one block per pixel.
     #[error("zoom must be at least 1 block per pixel (got {0})")]
