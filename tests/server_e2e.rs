@@ -387,3 +387,105 @@ fn start_up_problems_exit_with_a_message_and_the_documented_code() {
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("cannot listen on") && stderr.contains(&address), "{stderr}");
 }
+
+#[test]
+fn a_flying_player_has_every_chunk_of_its_final_view() {
+    let mut server = Server::start(&repo().join("biomes"), 4);
+    let started = Instant::now();
+    // The client asks for more than the server's cap: the view it gets is the cap's.
+    let args = ["--name", "flyer", "--view", "6", "--cap", &VIEW.to_string(), "--distance", "500", "--speed", "25"];
+    let report = server.node("fly.js", &args.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+    println!(
+        "flight: {} ms for 500 blocks, {} chunks during it, {} missing on arrival, all in view {} ms later; \
+         {} ms in all",
+        report["flight_ms"],
+        report["flight_packets"],
+        report["missing_on_arrival"],
+        report["settle_ms"],
+        started.elapsed().as_millis()
+    );
+    if report["ok"] != Value::Bool(true) {
+        server.fail(&format!("the flight failed: {report}"));
+    }
+    let start_x = report["start"]["x"].as_f64().expect("start x");
+    let final_x = report["final"]["x"].as_f64().expect("final x");
+    assert!((final_x - start_x - 500.0).abs() < 1e-6, "flew from {start_x} to {final_x}");
+    // The script waited until no position of the capped view was missing; check it here against
+    // valence's own view too.
+    let chunk = &report["final"]["chunk"];
+    let centre = ChunkPos::new(chunk[0].as_i64().expect("x") as i32, chunk[1].as_i64().expect("z") as i32);
+    assert_eq!(centre.x, (final_x / 16.0).floor() as i32);
+    let view = ChunkView::new(centre, VIEW);
+    assert_eq!(report["final_view"].as_u64(), Some(view.iter().count() as u64), "{report}");
+    // Nothing beyond the capped view is held (the server unloaded what the flight left behind).
+    assert!(report["loaded"].as_u64() >= Some(view.iter().count() as u64), "{report}");
+    assert!(report["loaded"].as_u64() <= Some(ChunkView::new(centre, VIEW + 1).iter().count() as u64), "{report}");
+    // 500 blocks is 31 chunks: the view was refilled along the way.
+    assert!(report["ever_loaded"].as_u64() > Some(view.iter().count() as u64 + 31 * 9), "{report}");
+    server.expect_line(|l| l == "flyer left", LINE_TIMEOUT);
+    assert!(server.stop().success());
+}
+
+/// The numbers of the console's `queue:` line: (waiting, in flight, loaded, cached).
+fn queue_numbers(line: &str) -> (u64, u64, u64, u64) {
+    let numbers: Vec<u64> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().expect("number"))
+        .collect();
+    assert_eq!(numbers.len(), 4, "{line}");
+    (numbers[0], numbers[1], numbers[2], numbers[3])
+}
+
+impl Server {
+    /// `status`, answered with the numbers of its `queue:` line.
+    fn queue(&mut self) -> (u64, u64, u64, u64) {
+        self.command("status");
+        let line = self.expect_line(|l| l.starts_with("queue:"), LINE_TIMEOUT);
+        queue_numbers(&line)
+    }
+}
+
+#[test]
+fn twenty_players_joining_and_leaving_repeatedly_leave_no_chunks_behind() {
+    const BOTS: usize = 20;
+    const ROUNDS: usize = 3;
+    let mut server = Server::start(&repo().join("biomes"), 5);
+    let (_, _, baseline, _) = server.queue();
+    assert_eq!(baseline, 0, "chunks loaded before anyone joined");
+
+    let started = Instant::now();
+    let args = ["--bots", &BOTS.to_string(), "--rounds", &ROUNDS.to_string(), "--view", "2", "--stagger", "50"];
+    let report = server.node("churn.js", &args.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+    println!("churn: {report} in {} ms", started.elapsed().as_millis());
+    if report["ok"] != Value::Bool(true) {
+        server.fail(&format!("churn failed: {report}"));
+    }
+    for _ in 0..BOTS * ROUNDS {
+        server.expect_line(|l| l.starts_with("churn_") && l.ends_with(" left"), LINE_TIMEOUT);
+    }
+
+    // Everyone left: the tick after the last leaves, their chunks are unloaded. Ask until the
+    // loaded count is back to the baseline (each answer is a line; the wait is bounded).
+    let deadline = Instant::now() + LINE_TIMEOUT;
+    let (mut waiting, mut loaded, mut cached);
+    loop {
+        (waiting, _, loaded, cached) = server.queue();
+        if loaded == baseline || Instant::now() > deadline {
+            break;
+        }
+    }
+    assert_eq!(loaded, baseline, "chunks still loaded after every player left");
+    assert_eq!(waiting, 0, "chunks still wanted after every player left");
+    assert!(
+        cached <= server.config.server.chunk_cache,
+        "{cached} cached, the cap is {}",
+        server.config.server.chunk_cache
+    );
+    assert!(cached > 0, "the chunks players saw were not kept for revisits");
+
+    // Still serving: one more player joins, and the process is alive.
+    server.probe("after_churn", &[]);
+    assert!(server.child.try_wait().expect("process state").is_none(), "the server exited");
+    assert!(server.stop().success());
+}

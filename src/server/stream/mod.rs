@@ -5,6 +5,8 @@
 //! valence's viewer counts, which underflow when clients leave (valence issue #716).
 
 mod cache;
+#[cfg(test)]
+mod tests;
 mod workers;
 
 use std::collections::{HashMap, HashSet, VecDeque};
