@@ -55,12 +55,12 @@ fn run_commands(
         let command = line.trim();
         match command {
             "" => {}
-            "help" => println!("{HELP}"),
-            "seed" => println!("seed {}", setup.config.world.seed),
+            "help" => say!("{HELP}"),
+            "seed" => say!("seed {}", setup.config.world.seed),
             "stop" => stop.request(),
             "status" => print_status(streamer.as_deref_mut(), &clients),
             "reload" => reload(&mut setup, streamer.as_deref_mut()),
-            other => println!("unknown command {other:?}: type `help` for the list"),
+            other => say!("unknown command {other:?}: type `help` for the list"),
         }
     }
 }
@@ -68,26 +68,26 @@ fn run_commands(
 fn print_status(streamer: Option<&mut Streamer>, clients: &Query<&Username, With<Client>>) {
     let names: Vec<&str> = clients.iter().map(|u| u.0.as_str()).collect();
     match names.len() {
-        0 => println!("players: 0"),
-        n => println!("players: {n} ({})", names.join(", ")),
+        0 => say!("players: 0"),
+        n => say!("players: {n} ({})", names.join(", ")),
     }
     if let Some(s) = streamer {
         let st = s.status();
-        println!(
+        say!(
             "chunks: {:.1} generated/s (last 10 s), {} generated, {} failed, mean {:.1} ms each",
             st.per_second,
             st.generated,
             st.failed,
             st.mean_build.as_secs_f64() * 1000.0
         );
-        println!(
+        say!(
             "queue: {} waiting, {} in flight; {} loaded, {} cached",
             st.queued, st.in_flight, st.loaded, st.cached
         );
     }
     match resident_bytes() {
-        Some(bytes) => println!("memory: {:.1} MiB resident", bytes as f64 / (1024.0 * 1024.0)),
-        None => println!("memory: unknown (no /proc/self/statm)"),
+        Some(bytes) => say!("memory: {:.1} MiB resident", bytes as f64 / (1024.0 * 1024.0)),
+        None => say!("memory: unknown (no /proc/self/statm)"),
     }
 }
 
@@ -99,7 +99,7 @@ fn reload(setup: &mut WorldSetup, streamer: Option<&mut Streamer>) {
     match loaded {
         Ok(rules) => {
             let rules = Arc::new(rules);
-            println!(
+            say!(
                 "reloaded {} biome rules from {}; new chunks use them",
                 rules.rule_count(),
                 setup.biomes_dir.display()
@@ -109,7 +109,7 @@ fn reload(setup: &mut WorldSetup, streamer: Option<&mut Streamer>) {
                 s.set_rules(rules);
             }
         }
-        Err(e) => println!("reload failed, keeping the current rules: {e:#}"),
+        Err(e) => say!("reload failed, keeping the current rules: {e:#}"),
     }
 }
 

@@ -89,7 +89,7 @@ fn announce_listening(mut listening: ResMut<Listening>, exit_code: Res<ExitCode>
     let probe = SocketAddr::new(reachable(listening.address.ip()), listening.address.port());
     if TcpStream::connect_timeout(&probe, Duration::from_millis(200)).is_ok() {
         listening.announced = true;
-        println!(
+        say!(
             "listening on {} (Minecraft Java Edition 1.20.1); type `help` for console commands",
             listening.address
         );
@@ -123,14 +123,14 @@ fn stop_when_asked(
     }
     match stopping.0 {
         None => {
-            println!("stopping…");
+            say!("stopping…");
             for mut client in &mut clients {
                 client.write_packet(&DisconnectS2c { reason: "The server is stopping.".into_cow_text() });
             }
             stopping.0 = Some(server.current_tick());
         }
         Some(tick) if server.current_tick() > tick => {
-            println!("stopped");
+            say!("stopped");
             exit.send(AppExit);
         }
         Some(_) => {}

@@ -5,6 +5,15 @@
 //! [`Pipeline`](crate::terrain::Pipeline) through [`fill`](crate::fill)) or how blocks are
 //! chosen (the fill's). Data flows one way: server → fill → pipeline.
 
+/// Prints a line for the owner. A closed stdout (the console piped into a process that has
+/// exited) must not take the server down with a panic, so write errors are ignored.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod console;
 mod lifecycle;
 mod players;
@@ -65,9 +74,9 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
 
     let pipeline = Arc::new(Pipeline::new(config.world.seed, &config.terrain()));
     let generator = Arc::new(Generator::new(pipeline, config));
-    println!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
+    say!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
     let spawn = find_spawn(&generator, &rules);
-    println!("spawn point: x {} y {} z {}", spawn.block.x, spawn.block.y, spawn.block.z);
+    say!("spawn point: x {} y {} z {}", spawn.block.x, spawn.block.y, spawn.block.z);
 
     let exit = lifecycle::ExitCode::default();
     let mut app = App::new();

@@ -73,14 +73,14 @@ fn init_clients(
         pos.set(spawn.feet);
         *respawn = RespawnPosition { pos: spawn.block, yaw: 0.0 };
         *mode = settings.game_mode;
-        println!("{} joined", name.0);
+        say!("{} joined", name.0);
     }
 }
 
 fn announce_leaving(mut left: RemovedComponents<Client>, names: Query<&Username>) {
     for entity in left.iter() {
         if let Ok(name) = names.get(entity) {
-            println!("{} left", name.0);
+            say!("{} left", name.0);
         }
     }
 }
