@@ -8,6 +8,7 @@ use crate::terrain::Rect;
 
 use super::cells::{self, CELL};
 use super::columns::Columns;
+use super::plants::{self, Plant};
 use super::surface::{self, Ground, Site};
 use super::trees::{self, Tree};
 use super::{BiomePalette, Generator, SurfaceSample};
@@ -86,7 +87,63 @@ impl Generator {
         }
         let trees = self.trees(rules, &columns, x0, z0, CHUNK);
         trees::place(&mut chunk, &trees, x0, z0, v.min_y);
+        // Plants last, and only where every block they need is still air (tree blocks in a
+        // column do not depend on the chunk, so neither does this).
+        for lz in 0..CHUNK {
+            for lx in 0..CHUNK {
+                let Some((base_y, plant)) = self.plant_at(rules, &columns, &trees, x0 + lx, z0 + lz) else { continue };
+                let blocks = plant.blocks();
+                let ys = (base_y..).take(blocks.len()).map(|y| (y - v.min_y) as u32);
+                if ys.clone().all(|ly| chunk.block_state(lx as u32, ly, lz as u32).is_air()) {
+                    for (ly, b) in ys.zip(blocks) {
+                        chunk.set_block_state(lx as u32, ly, lz as u32, b);
+                    }
+                }
+            }
+        }
         chunk
+    }
+
+    /// The blocks of the plant on column (`x`, `z`), from the one above the ground upwards
+    /// (empty for bare ground), as [`chunk`](Self::chunk) places them where no tree stands.
+    pub fn plant_blocks(&self, rules: &BiomeRules, x: i64, z: i64) -> Vec<BlockState> {
+        let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
+        let trees = self.trees(rules, &columns, x, z, 1);
+        self.plant_at(rules, &columns, &trees, x, z).map_or_else(Vec::new, |(_, p)| p.blocks())
+    }
+
+    /// The plant of column (`x`, `z`) and the Y of its lowest block, or `None`. `trees` must
+    /// hold every tree rooted within `REACH` of the column and `columns` cover
+    /// [`tree_rect`] of it. Cacti grow only where their four neighbours stay air at every
+    /// height they reach: lower ground, no plant and no tree nearby.
+    fn plant_at(&self, rules: &BiomeRules, columns: &Columns, trees: &[Tree], x: i64, z: i64) -> Option<(i32, Plant)> {
+        let v = &self.vertical;
+        let candidate = |x: i64, z: i64| -> Option<(i32, Plant)> {
+            let ground_y = columns.surface_y(x, z);
+            if ground_y < v.water_top_y() || columns.drop_blocks(x, z) >= surface::STEEP_DROP_BLOCKS {
+                return None;
+            }
+            let biome = self.surface_biome(rules, columns, x, z);
+            let ground = self.ground_at(columns, biome, x, z);
+            if ground.top.is_liquid() {
+                return None;
+            }
+            plants::candidate(self.seed, biome, ground.top, x, z).map(|p| (ground_y + 1, p))
+        };
+        let (base_y, plant) = candidate(x, z)?;
+        if base_y + plant.blocks().len() as i32 > v.min_y + v.height {
+            return None;
+        }
+        if let Plant::Cactus(_) = plant {
+            let near_tree = trees.iter().any(|t| (t.x - x).abs() <= trees::REACH && (t.z - z).abs() <= trees::REACH);
+            let crowded = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .into_iter()
+                .any(|(dx, dz)| columns.surface_y(x + dx, z + dz) >= base_y || candidate(x + dx, z + dz).is_some());
+            if near_tree || crowded {
+                return None;
+            }
+        }
+        Some((base_y, plant))
     }
 
     /// True when no tree stands on or over column (`x`, `z`) (a place to put a player).

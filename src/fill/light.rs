@@ -124,7 +124,7 @@ impl Section {
 /// How much sky light a block takes away: all of it for opaque blocks, one level for water,
 /// ice and leaves, nothing for air and small plants.
 fn dampening(block: BlockState) -> u8 {
-    if block.is_air() {
+    if block.is_air() || super::plants::is_plant(block) {
         0
     } else if block.is_opaque() {
         15

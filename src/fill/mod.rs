@@ -11,6 +11,7 @@ mod chunk;
 mod columns;
 mod hash;
 mod light;
+mod plants;
 mod surface;
 mod trees;
 mod vertical;
@@ -27,6 +28,7 @@ use crate::terrain::Pipeline;
 pub use chunk::CHUNK;
 pub use columns::{Columns, BLOCK_METRES};
 pub use light::SkyLight;
+pub use plants::is_plant;
 pub use surface::{Ground, Site};
 pub use vertical::Vertical;
 

@@ -59,12 +59,12 @@ fn is_tree(b: BlockState) -> bool {
     name.ends_with("_log") || name.ends_with("_leaves")
 }
 
-/// Highest ground block of a chunk column (not air, not tree): (world Y, block).
+/// Highest ground block of a chunk column (not air, not tree, not plant): (world Y, block).
 fn top(chunk: &UnloadedChunk, v: &Vertical, lx: u32, lz: u32) -> (i32, BlockState) {
     (0..chunk.height())
         .rev()
         .map(|y| (y, chunk.block_state(lx, y, lz)))
-        .find(|(_, b)| !b.is_air() && !is_tree(*b))
+        .find(|(_, b)| !b.is_air() && !is_tree(*b) && !is_plant(*b))
         .map_or((v.min_y, BlockState::AIR), |(y, b)| (y as i32 + v.min_y, b))
 }
 
@@ -196,4 +196,137 @@ fn woodland_grows_trees_that_stand_on_the_ground() {
     }
     // 70 % of the 5×5 cells of 8 land chunks: about 50 trees, fewer on steep or wet ground.
     assert!(trunks >= 10, "only {trunks} trees in 8 forest chunks");
+}
+
+fn single_biome(biome: &str) -> BiomeRules {
+    let source = format!("fallback = \"minecraft:{biome}\"\n");
+    BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source)]).expect("single-biome rules")
+}
+
+/// `n` land chunks near the origin, well above the sea.
+fn land_chunks(g: &Generator, rules: &BiomeRules, n: usize) -> Vec<(i32, i32)> {
+    let v = *g.vertical();
+    let land: Vec<(i32, i32)> = (-30..30)
+        .flat_map(|cz| (-30..30).map(move |cx| (cx, cz)))
+        .filter(|&(cx, cz)| g.surface(rules, i64::from(cx) * 16 + 8, i64::from(cz) * 16 + 8).y > v.sea_level_y + 2)
+        .take(n)
+        .collect();
+    assert_eq!(land.len(), n, "not enough land near the origin");
+    land
+}
+
+/// The plant blocks standing on the ground of a chunk column, bottom up.
+fn plant_on(chunk: &UnloadedChunk, v: &Vertical, lx: u32, lz: u32) -> Vec<BlockState> {
+    let (ground_y, _) = top(chunk, v, lx, lz);
+    ((ground_y + 1 - v.min_y) as u32..chunk.height())
+        .map(|y| chunk.block_state(lx, y, lz))
+        .take_while(|&b| is_plant(b))
+        .collect()
+}
+
+#[test]
+fn vegetation_matches_the_per_column_function_across_chunk_borders() {
+    for (biome, seed) in [("plains", 4), ("desert", 6)] {
+        let (g, rules, palette) = (generator(seed), single_biome(biome), palette());
+        let v = *g.vertical();
+        let mut plants = 0;
+        for (cx, cz) in land_chunks(&g, &rules, 2) {
+            let chunk = g.chunk(&rules, &palette, cx, cz);
+            let again = g.chunk(&rules, &palette, cx, cz);
+            for lz in 0..16u32 {
+                for lx in 0..16u32 {
+                    let (x, z) = (i64::from(cx) * 16 + i64::from(lx), i64::from(cz) * 16 + i64::from(lz));
+                    let seen = plant_on(&chunk, &v, lx, lz);
+                    assert_eq!(seen, plant_on(&again, &v, lx, lz), "not deterministic at ({x}, {z})");
+                    plants += usize::from(!seen.is_empty());
+                    // Queried over a different rectangle of the pipeline; trees may crowd
+                    // plants out, but never add any.
+                    let alone = g.plant_blocks(&rules, x, z);
+                    if g.clear_of_trees(&rules, x, z) {
+                        assert_eq!(seen, alone, "{biome} column ({x}, {z})");
+                    } else {
+                        assert!(seen.is_empty() || seen == alone, "{biome} column ({x}, {z})");
+                    }
+                }
+            }
+        }
+        assert!(plants > 0, "no plants in two {biome} chunks");
+    }
+}
+
+#[test]
+fn deserts_grow_cacti_and_dead_bushes_and_no_cactus_touches_a_block() {
+    let (g, rules, palette) = (generator(6), single_biome("desert"), palette());
+    let v = *g.vertical();
+    let (cx, cz) = land_chunks(&g, &rules, 1)[0];
+    // A 3×3 block of chunks, read as one area, so neighbours across borders are checked too.
+    let chunks: Vec<Vec<UnloadedChunk>> =
+        (-1..=1).map(|dz| (-1..=1).map(|dx| g.chunk(&rules, &palette, cx + dx, cz + dz)).collect()).collect();
+    let (x0, z0) = (i64::from(cx - 1) * 16, i64::from(cz - 1) * 16);
+    let at = |x: i64, y: i32, z: i64| {
+        let (ox, oz) = (x - x0, z - z0);
+        chunks[(oz / 16) as usize][(ox / 16) as usize].block_state(
+            (ox % 16) as u32,
+            (y - v.min_y) as u32,
+            (oz % 16) as u32,
+        )
+    };
+    let (mut cacti, mut bushes) = (0, 0);
+    for x in x0 + 1..x0 + 47 {
+        for z in z0 + 1..z0 + 47 {
+            for y in v.min_y..v.min_y + v.height {
+                let b = at(x, y, z);
+                assert!(
+                    !matches!(b, BlockState::GRASS | BlockState::TALL_GRASS | BlockState::FERN),
+                    "grass in a desert"
+                );
+                if b == BlockState::DEAD_BUSH {
+                    bushes += 1;
+                }
+                if b == BlockState::CACTUS {
+                    cacti += 1;
+                    for (dx, dz) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+                        let n = at(x + dx, y, z + dz);
+                        assert!(n.is_air(), "cactus at ({x}, {y}, {z}) touches {n:?}");
+                    }
+                    let below = at(x, y - 1, z);
+                    assert!(matches!(below, BlockState::SAND | BlockState::CACTUS), "cactus on {below:?}");
+                }
+            }
+        }
+    }
+    assert!(cacti > 0 && bushes > 0, "{cacti} cactus blocks and {bushes} dead bushes in 9 desert chunks");
+}
+
+#[test]
+fn plains_grow_grass_and_flowers_and_plants_let_the_sky_light_through() {
+    let (g, rules, palette) = (generator(4), single_biome("plains"), palette());
+    let v = *g.vertical();
+    let (mut grass, mut flowers) = (0, 0);
+    for (cx, cz) in land_chunks(&g, &rules, 2) {
+        let chunk = g.chunk(&rules, &palette, cx, cz);
+        let light = SkyLight::of(&chunk);
+        for lz in 0..16u32 {
+            for lx in 0..16u32 {
+                let seen = plant_on(&chunk, &v, lx, lz);
+                match seen.first() {
+                    Some(&BlockState::GRASS) => grass += 1,
+                    Some(b) if matches!(b.to_kind().to_str(), "dandelion" | "poppy" | "cornflower" | "oxeye_daisy") => {
+                        flowers += 1
+                    }
+                    _ => {}
+                }
+                if !seen.is_empty() {
+                    let (ground_y, ground) = top(&chunk, &v, lx, lz);
+                    assert!(!matches!(ground, BlockState::SNOW_BLOCK | BlockState::STONE | BlockState::WATER));
+                    let above = (ground_y + 1 - v.min_y) as u32;
+                    let covered = (above..chunk.height()).any(|y| is_tree(chunk.block_state(lx, y, lz)));
+                    if !covered {
+                        assert_eq!(light.get(lx, above, lz), 15, "a plant shades ({lx}, {lz}) of ({cx}, {cz})");
+                    }
+                }
+            }
+        }
+    }
+    assert!(grass > 20 && flowers > 0, "{grass} grass and {flowers} flowers in two plains chunks");
 }

@@ -67,7 +67,9 @@ fn walkable_column(generator: &Generator, rules: &BiomeRules, x0: i64, z0: i64, 
     candidates.into_iter().take(CHUNK as usize).find_map(|(x, z)| {
         let surface = generator.surface(rules, x, z);
         let solid = !matches!(surface.top, "powder_snow" | "water" | "ice");
-        (solid && generator.clear_of_trees(rules, x, z)).then(|| at(x, surface.y, z))
+        // Grass and flowers are walked through; a cactus is not a place to stand.
+        let no_cactus = !generator.plant_blocks(rules, x, z).contains(&BlockState::CACTUS);
+        (solid && no_cactus && generator.clear_of_trees(rules, x, z)).then(|| at(x, surface.y, z))
     })
 }
 

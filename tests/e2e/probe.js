@@ -109,7 +109,13 @@ function main () {
   bot.on('physicsTick', check)
 }
 
-// The ground of column (x, z): its highest block that is neither air nor part of a tree, with
+// Blocks the generator places on the ground as vegetation (see src/fill/plants.rs).
+const PLANTS = new Set([
+  'grass', 'tall_grass', 'fern', 'large_fern', 'dead_bush', 'cactus', 'sunflower', 'dandelion', 'poppy',
+  'cornflower', 'oxeye_daisy', 'azure_bluet', 'allium', 'pink_petals'
+])
+
+// The ground of column (x, z): its highest block that is neither air, a plant nor part of a tree, with
 // its biome and sky light, and whether anything (a tree) stands above it; null when the
 // column is not loaded yet.
 function topOf (bot, x, z, lit) {
@@ -119,6 +125,7 @@ function topOf (bot, x, z, lit) {
     const block = bot.blockAt(new Vec3(x, y, z))
     if (block === null) return null
     if (block.name === 'air' || block.name === 'cave_air' || block.name === 'void_air') continue
+    if (PLANTS.has(block.name)) continue // vegetation stands on the ground, it is not the ground
     if (block.name.endsWith('_log') || block.name.endsWith('_leaves')) {
       covered = true
       continue
