@@ -58,7 +58,7 @@ pub fn run(config: &Config, args: &BenchArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&doc)?);
     } else {
         println!("infiniterra bench — {threads} hardware threads, seed {}, median of {runs} runs", config.world.seed);
-        println!("{:<58} {:>14}  {}", "measurement", "median", "unit");
+        println!("{:<58} {:>14}  unit", "measurement", "median");
         for m in &all {
             println!("{:<58} {:>14.3}  {}", m.name, m.value, m.unit);
         }
