@@ -6,7 +6,9 @@ use clap::Args;
 
 use super::progress::Progress;
 use super::{Failure, Size};
+use crate::biome::BiomeRules;
 use crate::config::Config;
+use crate::fill::Generator;
 use crate::export::{self, ExportRequest, Grid, Vertical};
 use crate::render::{self, Layer, RenderRequest};
 use crate::terrain::Pipeline;
@@ -40,6 +42,9 @@ pub struct RenderArgs {
     /// Output PNG.
     #[arg(long)]
     pub out: PathBuf,
+    /// Folder of biome rules (for `--layer biome`).
+    #[arg(long, default_value = "biomes")]
+    pub biomes: PathBuf,
 }
 
 /// Arguments of `infiniterra export`.
@@ -75,9 +80,15 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
         return Err(Failure::input(anyhow::anyhow!("--zoom {} is out of range (allowed 1 or more)", a.zoom)));
     }
     let req = RenderRequest { x0: a.area.x0, z0: a.area.z0, width: a.area.size.width, height: a.area.size.height, zoom: a.zoom, layer: a.layer };
-    let pipeline = pipeline(config);
     let mut progress = Progress::new("render", "rows");
-    let image = render::render(&pipeline, &req, &mut |d, t| progress.update(d, t)).map_err(|e| classify(e.is_bad_input(), e))?;
+    let image = if a.layer == Layer::Biome {
+        let rules = BiomeRules::load_dir(&a.biomes).map_err(Failure::input)?;
+        let generator = Generator::new(std::sync::Arc::new(pipeline(config)), config);
+        render::render_biomes(&generator, &rules, &req, &mut |d, t| progress.update(d, t))
+    } else {
+        render::render(&pipeline(config), &req, &mut |d, t| progress.update(d, t))
+    }
+    .map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
     render::save_png(&image, &a.out).map_err(Failure::runtime)?;
     println!("wrote {} ({}×{} px)", a.out.display(), image.width(), image.height());

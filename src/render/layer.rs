@@ -21,7 +21,7 @@ pub enum Layer {
     Seasonality,
     /// Precipitation variability (coefficient of variation), %.
     Variability,
-    /// Minecraft biomes (not drawn yet: open work of issue #5).
+    /// Minecraft biomes, from the biome rules (see [`render_biomes`](super::render_biomes)).
     Biome,
 }
 

@@ -5,6 +5,7 @@
 //! Must not touch: terrain internals (only `Pipeline::model` / `Pipeline::columns`), the
 //! command line (the CLI parses flags into a [`RenderRequest`] and reports errors).
 
+mod biomes;
 mod layer;
 mod panel;
 mod ramp;
@@ -16,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
 
+pub use biomes::render_biomes;
 pub use layer::{Layer, UnknownLayer};
 
 use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
@@ -49,8 +51,8 @@ pub struct RenderRequest {
 /// Why a map cannot be drawn.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// The biome layer is requested before biome rules exist.
-    #[error("biome maps are not drawn yet (open work of issue #5); the server applies the biome rules in game")]
+    /// The biome layer needs the biome rules: use [`render_biomes`].
+    #[error("the biome layer is drawn by render_biomes, which needs the biome rules")]
     BiomeNeedsRules,
     /// Zoom below one block per pixel.
     #[error("zoom must be at least 1 block per pixel (got {0})")]
@@ -153,7 +155,7 @@ pub(crate) fn block_metres() -> f64 {
 }
 
 /// Validates the request; returns the map's size in pixels.
-fn check(req: &RenderRequest) -> Result<(u32, u32), RenderError> {
+pub(crate) fn check(req: &RenderRequest) -> Result<(u32, u32), RenderError> {
     if req.zoom < 1 {
         return Err(RenderError::BadZoom(req.zoom));
     }
@@ -182,7 +184,7 @@ fn check(req: &RenderRequest) -> Result<(u32, u32), RenderError> {
     Ok((w as u32, h as u32))
 }
 
-fn title_lines(req: &RenderRequest, seed: u64, stages: &[String]) -> Vec<String> {
+pub(crate) fn title_lines(req: &RenderRequest, seed: u64, stages: &[String]) -> Vec<String> {
     let stages = if stages.is_empty() { "none".to_string() } else { stages.join(", ") };
     vec![
         format!("{} - seed {} - stages: {}", req.layer, seed, stages),

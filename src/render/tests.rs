@@ -123,7 +123,7 @@ fn pipeline() -> Pipeline {
 fn biome_layer_needs_rules() {
     let err = render(&pipeline(), &request(Layer::Biome), &mut |_, _| {}).unwrap_err();
     assert!(matches!(err, RenderError::BiomeNeedsRules));
-    assert!(err.to_string().contains("issue #5"));
+    assert!(err.to_string().contains("render_biomes"));
 }
 
 #[test]
