@@ -8,8 +8,8 @@ use super::progress::Progress;
 use super::{Failure, Size};
 use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::fill::Generator;
 use crate::export::{self, ExportRequest, Grid, Vertical};
+use crate::fill::Generator;
 use crate::render::{self, Layer, RenderRequest};
 use crate::terrain::Pipeline;
 
@@ -79,7 +79,14 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
     if a.zoom < 1 {
         return Err(Failure::input(anyhow::anyhow!("--zoom {} is out of range (allowed 1 or more)", a.zoom)));
     }
-    let req = RenderRequest { x0: a.area.x0, z0: a.area.z0, width: a.area.size.width, height: a.area.size.height, zoom: a.zoom, layer: a.layer };
+    let req = RenderRequest {
+        x0: a.area.x0,
+        z0: a.area.z0,
+        width: a.area.size.width,
+        height: a.area.size.height,
+        zoom: a.zoom,
+        layer: a.layer,
+    };
     let mut progress = Progress::new("render", "rows");
     let image = if a.layer == Layer::Biome {
         let rules = BiomeRules::load_dir(&a.biomes).map_err(Failure::input)?;
@@ -97,12 +104,19 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
 
 /// Runs `export`.
 pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
-    let req = ExportRequest { x0: a.area.x0, z0: a.area.z0, width: a.area.size.width, height: a.area.size.height, grid: a.grid };
-    let vertical = Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
+    let req = ExportRequest {
+        x0: a.area.x0,
+        z0: a.area.z0,
+        width: a.area.size.width,
+        height: a.area.size.height,
+        grid: a.grid,
+    };
+    let vertical =
+        Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
     let pipeline = pipeline(config);
     let mut progress = Progress::new("export", "rows");
-    let summary =
-        export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t)).map_err(|e| classify(e.is_bad_input(), e))?;
+    let summary = export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t))
+        .map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
     println!(
         "wrote {} ({}×{}, {:.1}..{:.1} m) and {}",

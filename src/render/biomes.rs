@@ -124,7 +124,8 @@ fn frame(map: RgbImage, title: &[String], counts: HashMap<String, u64>) -> RgbIm
         let x = (margin + (i % per_row) as u32 * column) as i64;
         let row_y = y + (i / per_row) as i64 * line as i64;
         text::fill(&mut img, x, row_y, text::GLYPH * scale, text::GLYPH * scale, colour(name));
-        let label = format!("{} {:.1}%", name.strip_prefix("minecraft:").unwrap_or(name), 100.0 * *n as f64 / total as f64);
+        let label =
+            format!("{} {:.1}%", name.strip_prefix("minecraft:").unwrap_or(name), 100.0 * *n as f64 / total as f64);
         text::draw(&mut img, x + (text::GLYPH * scale + 4 * scale) as i64, row_y, &label, scale, ink);
     }
     img

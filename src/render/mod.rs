@@ -130,12 +130,13 @@ pub fn render(
     // An elevation map needs no climate (channel 0 is elevation either way), which makes
     // maps of huge areas far cheaper.
     let elevation_only = req.layer == Layer::Elevation;
-    let (grid, mut query): (CellGrid, Box<dyn FnMut(Rect) -> Tile>) = match (req.zoom < BLOCKS_PER_MODEL_PIXEL, elevation_only) {
-        (true, true) => (CellGrid::BLOCKS, Box::new(|r| pipeline.elevation_columns(r))),
-        (true, false) => (CellGrid::BLOCKS, Box::new(|r| pipeline.columns(r))),
-        (false, true) => (CellGrid::MODEL, Box::new(|r| pipeline.elevation(r))),
-        (false, false) => (CellGrid::MODEL, Box::new(|r| pipeline.model(r))),
-    };
+    let (grid, mut query): (CellGrid, Box<dyn FnMut(Rect) -> Tile>) =
+        match (req.zoom < BLOCKS_PER_MODEL_PIXEL, elevation_only) {
+            (true, true) => (CellGrid::BLOCKS, Box::new(|r| pipeline.elevation_columns(r))),
+            (true, false) => (CellGrid::BLOCKS, Box::new(|r| pipeline.columns(r))),
+            (false, true) => (CellGrid::MODEL, Box::new(|r| pipeline.elevation(r))),
+            (false, false) => (CellGrid::MODEL, Box::new(|r| pipeline.model(r))),
+        };
     Ok(draw(req, size, &style, &title, grid, &mut *query, progress))
 }
 

@@ -80,10 +80,7 @@ fn print_status(streamer: Option<&mut Streamer>, clients: &Query<&Username, With
             st.failed,
             st.mean_build.as_secs_f64() * 1000.0
         );
-        say!(
-            "queue: {} waiting, {} in flight; {} loaded, {} cached",
-            st.queued, st.in_flight, st.loaded, st.cached
-        );
+        say!("queue: {} waiting, {} in flight; {} loaded, {} cached", st.queued, st.in_flight, st.loaded, st.cached);
     }
     match resident_bytes() {
         Some(bytes) => say!("memory: {:.1} MiB resident", bytes as f64 / (1024.0 * 1024.0)),

@@ -89,10 +89,7 @@ fn announce_listening(mut listening: ResMut<Listening>, exit_code: Res<ExitCode>
     let probe = SocketAddr::new(reachable(listening.address.ip()), listening.address.port());
     if TcpStream::connect_timeout(&probe, Duration::from_millis(200)).is_ok() {
         listening.announced = true;
-        say!(
-            "listening on {} (Minecraft Java Edition 1.20.1); type `help` for console commands",
-            listening.address
-        );
+        say!("listening on {} (Minecraft Java Edition 1.20.1); type `help` for console commands", listening.address);
     } else if listening.since.elapsed() > LISTEN_TIMEOUT {
         tracing::error!("the server did not start listening on {} (see the log above)", listening.address);
         exit_code.fail();

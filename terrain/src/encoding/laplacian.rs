@@ -128,7 +128,8 @@ mod tests {
         let (h, w) = (64, 64);
         let x = terrain_like(h, w);
         let (low, res) = laplacian_split(&x, h, w);
-        let noisy: Vec<f32> = low.iter().enumerate().map(|(i, v)| v + if i % 2 == 0 { 300.0 } else { -300.0 }).collect();
+        let noisy: Vec<f32> =
+            low.iter().enumerate().map(|(i, v)| v + if i % 2 == 0 { 300.0 } else { -300.0 }).collect();
         let err = |v: &[f32]| v.iter().zip(&x).map(|(a, b)| (a - b).powi(2)).sum::<f32>().sqrt();
         let plain = laplacian_merge(&noisy, &res, h, w);
         let cleaned = laplacian_denoise(&noisy, &res, h, w);

@@ -59,7 +59,11 @@ impl WindowFn for Smear {
                     for y in r.y0..r.y1() {
                         for x in r.x0..r.x1() {
                             let s = src.get(ci, y, x) * 0.4
-                                + 0.15 * (src.get(ci, y - 1, x) + src.get(ci, y + 1, x) + src.get(ci, y, x - 1) + src.get(ci, y, x + 1));
+                                + 0.15
+                                    * (src.get(ci, y - 1, x)
+                                        + src.get(ci, y + 1, x)
+                                        + src.get(ci, y, x - 1)
+                                        + src.get(ci, y, x + 1));
                             let i = (c * r.h as usize + (y - r.y0) as usize) * r.w as usize + (x - r.x0) as usize;
                             out.data[i] = s.tanh() + 0.1 * ((w.iy * 7 + w.ix * 3) as f32).sin();
                         }
@@ -115,7 +119,8 @@ fn region_by_parts(c: &Chain, whole: Rect, part: i64, order_seed: u64) -> Tile {
         for ch in 0..2 {
             for y in r.y0..r.y1() {
                 for x in r.x0..r.x1() {
-                    let i = (ch * whole.h as usize + (y - whole.y0) as usize) * whole.w as usize + (x - whole.x0) as usize;
+                    let i =
+                        (ch * whole.h as usize + (y - whole.y0) as usize) * whole.w as usize + (x - whole.x0) as usize;
                     out.data[i] = t.get(ch, y, x);
                 }
             }
@@ -128,9 +133,14 @@ fn region_by_parts(c: &Chain, whole: Rect, part: i64, order_seed: u64) -> Tile {
 fn same_region_is_bit_identical_across_orders_caches_and_threads() {
     let whole = Rect::new(-37, 1000, 60, 52);
     let reference = chain(11, 64 << 20, 1).step0.query(whole);
-    for (cache, threads, part, order) in
-        [(64 << 20, 1, 7, 1), (64 << 20, 4, 13, 2), (3_000, 1, 5, 3), (3_000, 4, 9, 4), (0, 4, 11, 5), (200_000, 2, 17, 6)]
-    {
+    for (cache, threads, part, order) in [
+        (64 << 20, 1, 7, 1),
+        (64 << 20, 4, 13, 2),
+        (3_000, 1, 5, 3),
+        (3_000, 4, 9, 4),
+        (0, 4, 11, 5),
+        (200_000, 2, 17, 6),
+    ] {
         let c = chain(11, cache, threads);
         let got = region_by_parts(&c, whole, part, order);
         assert!(got.data == reference.data, "cache {cache} threads {threads} part {part} differs");
@@ -232,7 +242,9 @@ fn far_queries_cost_the_same_number_of_windows() {
     let at_origin = count(0, 0);
     let l0 = chain(1, 0, 1).step0.layout();
     let bound0 = l0.max_windows(32, 32) as u64;
-    for (y, x) in [(-7_500_000, 7_500_000), (7_500_000, -7_500_000), (30_000_000, 30_000_000), (-30_000_000, -29_999_999)] {
+    for (y, x) in
+        [(-7_500_000, 7_500_000), (7_500_000, -7_500_000), (30_000_000, 30_000_000), (-30_000_000, -29_999_999)]
+    {
         let far = count(y, x);
         assert!(far.0 <= bound0 && at_origin.0 <= bound0, "step 0: {far:?} vs {at_origin:?}, bound {bound0}");
         // Alignment can shift one row/column of windows; the bound is the layout's own.

@@ -40,7 +40,8 @@ pub mod channel {
     /// Number of channels.
     pub const COUNT: usize = 5;
     /// Channel names, in order, for files and legends.
-    pub const NAMES: [&str; COUNT] = ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct"];
+    pub const NAMES: [&str; COUNT] =
+        ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct"];
 }
 
 /// The terrain pipeline for one seed: thread-safe, shared by every chunk worker.

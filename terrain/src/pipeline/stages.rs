@@ -27,10 +27,26 @@ pub struct StageStatus {
 pub fn current() -> Vec<StageStatus> {
     const LEARNED: &str = "learned model not trained yet (issue #4): the layout stands in";
     vec![
-        StageStatus { name: "layout", role: "procedural continental sketch (fBm, quantile-mapped)", state: StageState::Active },
-        StageStatus { name: "coarse", role: "refines the sketch: continents, shelves, basins", state: StageState::Missing { reason: LEARNED } },
-        StageStatus { name: "core", role: "relief at the native resolution", state: StageState::Missing { reason: LEARNED } },
+        StageStatus {
+            name: "layout",
+            role: "procedural continental sketch (fBm, quantile-mapped)",
+            state: StageState::Active,
+        },
+        StageStatus {
+            name: "coarse",
+            role: "refines the sketch: continents, shelves, basins",
+            state: StageState::Missing { reason: LEARNED },
+        },
+        StageStatus {
+            name: "core",
+            role: "relief at the native resolution",
+            state: StageState::Missing { reason: LEARNED },
+        },
         StageStatus { name: "detail", role: "high-frequency residual", state: StageState::Missing { reason: LEARNED } },
-        StageStatus { name: "climate", role: "lapse-rate temperature, orographic precipitation", state: StageState::Active },
+        StageStatus {
+            name: "climate",
+            role: "lapse-rate temperature, orographic precipitation",
+            state: StageState::Active,
+        },
     ]
 }

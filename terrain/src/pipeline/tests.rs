@@ -26,9 +26,13 @@ fn a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
     let reference = pipeline(77, 256, 1).columns(whole);
     for (cache_mib, threads, order) in [(256, 4, 1), (1, 1, 2), (1, 4, 3)] {
         let p = pipeline(77, cache_mib, threads);
-        let chunks: Vec<Rect> = (0..36).map(|i| Rect::new(whole.y0 + (i / 6) * 16, whole.x0 + (i % 6) * 16, 16, 16)).collect();
+        let chunks: Vec<Rect> =
+            (0..36).map(|i| Rect::new(whole.y0 + (i / 6) * 16, whole.x0 + (i % 6) * 16, 16, 16)).collect();
         for r in shuffled(chunks, order) {
-            assert!(p.columns(r) == reference.crop(r), "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)");
+            assert!(
+                p.columns(r) == reference.crop(r),
+                "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)"
+            );
         }
     }
     assert_ne!(pipeline(78, 256, 1).columns(whole).data, reference.data, "the seed must matter");
@@ -38,7 +42,8 @@ fn a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
 fn neighbouring_chunks_agree_with_one_big_query() {
     let p = pipeline(5, 64, 2);
     let big = p.columns(Rect::new(-40, -40, 80, 80));
-    for r in [Rect::new(-40, -40, 16, 16), Rect::new(-24, -40, 16, 16), Rect::new(-1, -1, 2, 2), Rect::new(7, 33, 1, 7)] {
+    for r in [Rect::new(-40, -40, 16, 16), Rect::new(-24, -40, 16, 16), Rect::new(-1, -1, 2, 2), Rect::new(7, 33, 1, 7)]
+    {
         assert!(p.columns(r) == big.crop(r), "{r:?}");
     }
 }
@@ -60,7 +65,10 @@ fn far_away_costs_the_same_windows_and_never_overflows() {
     assert!(origin > 0 && origin <= bound);
     for (x, z) in [(30_000_000, 30_000_000), (-30_000_000, -30_000_000), (-30_000_000, 29_999_488), (12_345_678, -7)] {
         let far = count(x, z);
-        assert!(far <= bound && (far - origin).abs() <= bound - layout.max_windows(1, 1), "{far} windows at {x},{z} vs {origin}");
+        assert!(
+            far <= bound && (far - origin).abs() <= bound - layout.max_windows(1, 1),
+            "{far} windows at {x},{z} vs {origin}"
+        );
     }
 }
 
