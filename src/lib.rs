@@ -14,5 +14,7 @@ pub mod export;
 pub mod fill;
 pub mod render;
 pub mod server;
+#[cfg(feature = "learned")]
+pub mod train;
 
 pub use infiniterra_terrain as terrain;

@@ -47,7 +47,11 @@ pub enum Command {
     Data(crate::eval::DataArgs),
     /// Measure how realistic generated terrain is against real terrain.
     Eval(crate::eval::EvalArgs),
-    /// Train a stage of the model hierarchy.
+    /// Train a stage of the model hierarchy (`--seed` sets the training seed).
+    #[cfg(feature = "learned")]
+    Train(crate::train::TrainArgs),
+    /// Train a stage of the model hierarchy (needs a build with `--features learned`).
+    #[cfg(not(feature = "learned"))]
     Train {
         /// Any further arguments.
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
@@ -131,7 +135,13 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
                 Err(e) => Err(Failure::runtime(e)),
             }
         }
-        Command::Train { .. } => not_yet("train", 4, "learned terrain"),
+        #[cfg(feature = "learned")]
+        Command::Train(a) => crate::train::run(a, cli.seed),
+        #[cfg(not(feature = "learned"))]
+        Command::Train { .. } => Err(Failure::runtime(anyhow::anyhow!(
+            "`infiniterra train` is in this build only with the learned-model code: \
+             `cargo run --release --features learned -- train STAGE` (learned terrain is issue #4, in progress)"
+        ))),
         Command::Pregen { .. } => not_yet("pregen", 6, "pre-generation and Anvil persistence"),
         Command::Bench(a) => crate::bench::run(&load_config(&cli)?, a).map_err(Failure::runtime),
     }
@@ -139,5 +149,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 
 /// Commands that a later issue delivers: say so and fail, never pretend.
 fn not_yet(command: &str, issue: u32, what: &str) -> Result<(), Failure> {
-    Err(Failure::runtime(anyhow::anyhow!("`infiniterra {command}` is not built yet: {what} arrives with issue #{issue}")))
+    Err(Failure::runtime(anyhow::anyhow!(
+        "`infiniterra {command}` is not built yet: {what} arrives with issue #{issue}"
+    )))
 }

@@ -9,6 +9,8 @@ pub mod encoding;
 pub mod infinite;
 pub mod layout;
 pub mod metrics;
+#[cfg(feature = "learned")]
+pub mod model;
 pub mod noise;
 pub mod pipeline;
 pub mod settings;

@@ -1,0 +1,78 @@
+use std::sync::atomic::AtomicBool;
+
+use super::*;
+
+fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
+    TrainArgs {
+        stage: "core".into(),
+        steps,
+        resume,
+        batch: 2,
+        crop: 32,
+        lr: 4e-3,
+        lr_ref_steps: 2,
+        ema: 0.9,
+        data: PathBuf::from("unused"),
+        out: out.to_path_buf(),
+        checkpoint_every: 2,
+        preview_every: 1000,
+        log_every: 1,
+        minutes: None,
+        precision: Precision::F32,
+        backend: ComputeBackend::Cpu,
+        tiles: 0,
+        generate_heldout: None,
+        smoke: true,
+    }
+}
+
+fn train(args: &TrainArgs) -> CheckpointState {
+    let spec = stage_spec("core", true).expect("core is trainable");
+    let mut t = Trainer::new(args, 5, spec, data::synthetic(6, 128), data::synthetic(2, 128)).expect("trainer");
+    t.run(&AtomicBool::new(false)).expect("training runs");
+    t.state
+}
+
+fn tempdir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("infiniterra-train-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn training_is_deterministic_and_resumes_exactly() {
+    let straight = tempdir("straight");
+    let a = train(&smoke_args(&straight, 4, false));
+    assert_eq!(a.step, 4);
+    assert!(a.losses.iter().all(|(_, l)| l.is_finite()));
+
+    let resumed = tempdir("resumed");
+    let half = train(&smoke_args(&resumed, 2, false));
+    assert_eq!(half.step, 2);
+    let b = train(&smoke_args(&resumed, 4, true));
+    assert_eq!(b.step, 4);
+    // Same losses step by step, same shipped weights byte for byte.
+    let tail = |s: &CheckpointState| s.losses.iter().filter(|(k, _)| *k > 2).cloned().collect::<Vec<_>>();
+    assert_eq!(tail(&a), tail(&b));
+    let weights = |d: &Path| std::fs::read(d.join("core.safetensors")).expect("shipped weights");
+    assert_eq!(weights(&straight), weights(&resumed));
+    let manifest: ModelManifest =
+        serde_json::from_str(&std::fs::read_to_string(resumed.join("core.json")).expect("manifest")).expect("parses");
+    assert_eq!(manifest.training.steps, 4);
+    assert!(manifest.parameters > 0 && !manifest.weights_sha256.is_empty());
+    assert!(resumed.join("checkpoints/core/samples_000004.png").exists());
+    let _ = std::fs::remove_dir_all(&straight);
+    let _ = std::fs::remove_dir_all(&resumed);
+}
+
+#[test]
+fn resuming_without_a_checkpoint_is_an_input_error() {
+    let dir = tempdir("nockpt");
+    let spec = stage_spec("core", true).expect("core");
+    let err = Trainer::new(&smoke_args(&dir, 4, true), 0, spec, data::synthetic(2, 64), data::synthetic(1, 64))
+        .err()
+        .expect("no checkpoint to resume");
+    assert_eq!(err.code, 2);
+    assert!(err.error.to_string().contains("state.json"), "{}", err.error);
+    assert!(stage_spec("canyon", false).is_err());
+}

@@ -1,0 +1,130 @@
+//! Learned stages as window functions of the infinite-tensor engine.
+//!
+//! [`CoreStage`] runs the core model on 64×64 windows (stride 32: ≈50 % overlap) of its own
+//! grid. Its conditioning is a field 8× coarser than that grid (the coarse stage, or the
+//! layout standing in for it), bilinearly upsampled from globally aligned cells so every
+//! window sees the same values where windows overlap. Its noise comes from
+//! [`GaussianNoise`] keyed by (seed, stage, sampler step, global tile), so the result is a pure
+//! function of (seed, region). The whole few-step sampler runs inside each window (T = 1
+//! blending step); overlapping outputs are blended by the engine's tent weights.
+
+use std::sync::Arc;
+
+use burn::tensor::{Device, Tensor, TensorData};
+
+use super::store::{LoadedModel, Normalisation};
+use super::{Sampler, UNet};
+use crate::encoding::{signed_sqrt, signed_square, LAPLACIAN_FACTOR};
+use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
+use crate::noise::{GaussianNoise, NoiseKey};
+use crate::tile::{Rect, Tile};
+use crate::upsample;
+
+/// Noise stream number of the core stage (each stage has its own).
+pub const CORE_NOISE_STAGE: u32 = 2;
+
+/// The core model as a [`WindowFn`]: elevation in metres (one channel) on its grid.
+pub struct CoreStage {
+    net: UNet,
+    device: Device,
+    sampler: Sampler,
+    norm: Normalisation,
+    coarse: Arc<dyn Source>,
+    seed: u64,
+    window: i64,
+    stride: i64,
+    batch: usize,
+}
+
+impl CoreStage {
+    /// The core stage of world `seed`: `model` on `device`, conditioned on `coarse` (elevation
+    /// in metres on a grid [`LAPLACIAN_FACTOR`]× coarser than the output), windows of the
+    /// model's size with half-window stride, `batch` windows per network call.
+    pub fn new(model: LoadedModel, device: Device, coarse: Arc<dyn Source>, seed: u64, batch: usize) -> CoreStage {
+        let window = model.manifest.window as i64;
+        CoreStage {
+            sampler: model.manifest.sampler.clone(),
+            norm: model.manifest.normalisation.clone(),
+            net: model.net,
+            device,
+            coarse,
+            seed,
+            window,
+            stride: window / 2,
+            batch: batch.max(1),
+        }
+    }
+
+    /// The conditioning of one window, in the network's units, and the un-normalised
+    /// signed-sqrt low band the output is added to.
+    fn context(&self, rect: Rect) -> (Vec<f32>, Vec<f32>) {
+        let f = LAPLACIAN_FACTOR as i64;
+        let coarse = self.coarse.query(upsample::source_rect(&rect, f));
+        let coarse = Tile::from_data(1, coarse.rect, coarse.data.iter().map(|&e| signed_sqrt(e)).collect());
+        let low = upsample::bilinear(&coarse, f, rect).data;
+        let cond = low.iter().map(|&v| (v - self.norm.cond_mean) / self.norm.cond_scale).collect();
+        (cond, low)
+    }
+}
+
+impl WindowFn for CoreStage {
+    fn name(&self) -> &str {
+        "core"
+    }
+
+    fn channels(&self) -> usize {
+        1
+    }
+
+    fn layout(&self) -> WindowLayout {
+        WindowLayout::square(self.window, self.stride, 0)
+    }
+
+    fn batch_size(&self) -> usize {
+        self.batch
+    }
+
+    fn eval(&self, windows: &[WindowIndex]) -> Vec<Tile> {
+        let layout = self.layout();
+        let (b, n) = (windows.len(), (self.window * self.window) as usize);
+        let side = self.window as usize;
+        let rects: Vec<Rect> = windows.iter().map(|&w| layout.rect(w)).collect();
+        let mut cond = Vec::with_capacity(b * n);
+        let mut lows = Vec::with_capacity(b);
+        for &r in &rects {
+            let (c, low) = self.context(r);
+            cond.extend_from_slice(&c);
+            lows.push(low);
+        }
+        let noises: Vec<Tensor<4>> = (0..self.sampler.noises_needed())
+            .map(|step| {
+                let source = GaussianNoise {
+                    key: NoiseKey { seed: self.seed, stage: CORE_NOISE_STAGE, step: step as u32 },
+                    channels: 1,
+                };
+                let mut values = Vec::with_capacity(b * n);
+                for &r in &rects {
+                    values.extend_from_slice(&source.query(r).data);
+                }
+                Tensor::from_data(TensorData::new(values, [b, 1, side, side]), &self.device)
+            })
+            .collect();
+        let cond = Tensor::<4>::from_data(TensorData::new(cond, [b, 1, side, side]), &self.device);
+        // Zeros: "no relief hint" (the network was trained with the vector dropped out).
+        let vector =
+            (self.net.config.vector_dim > 0).then(|| Tensor::<2>::zeros([b, self.net.config.vector_dim], &self.device));
+        let out = self.sampler.sample(&self.net, &noises, Some(cond), vector);
+        let values: Vec<f32> = out.into_data().try_into_vec().expect("the network outputs f32");
+        rects
+            .iter()
+            .zip(lows)
+            .enumerate()
+            .map(|(i, (&r, low))| {
+                let residual = &values[i * n..(i + 1) * n];
+                let metres =
+                    low.iter().zip(residual).map(|(&l, &x)| signed_square(l + x * self.norm.target_scale)).collect();
+                Tile::from_data(1, r, metres)
+            })
+            .collect()
+    }
+}

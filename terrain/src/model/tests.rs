@@ -1,0 +1,316 @@
+use std::sync::Arc;
+
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::tensor::{Device, Tensor, TensorData};
+
+use super::stage::CoreStage;
+use super::*;
+use crate::infinite::{Engine, EngineConfig, Source, Windowed};
+use crate::tile::{Rect, Tile};
+
+fn device() -> Device {
+    Device::flex()
+}
+
+fn randn<const D: usize>(shape: [usize; D], seed: u64) -> Tensor<D> {
+    let n = shape.iter().product();
+    Tensor::from_data(TensorData::new(HostRng::keyed(seed, 1, 2, 3).normals(n), shape), &device())
+}
+
+fn values<const D: usize>(t: Tensor<D>) -> Vec<f32> {
+    t.into_data().try_into_vec().expect("f32 tensor")
+}
+
+fn std_of<const D: usize>(t: Tensor<D>) -> f64 {
+    let v = values(t);
+    let mean = v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+    (v.iter().map(|&x| (x as f64 - mean).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn rms_of<const D: usize>(t: Tensor<D>) -> f64 {
+    let v = values(t);
+    (v.iter().map(|&x| (x as f64).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+#[test]
+fn unet_output_has_the_shape_of_its_input() {
+    let net = UNet::new(&UNetConfig::tiny(), 1, &device());
+    let x = randn([3, 1, 32, 32], 1);
+    let cond = randn([3, 1, 32, 32], 2);
+    let sigma = Tensor::<1>::from_data(TensorData::new(vec![0.1f32, 1.0, 10.0], [3]), &device());
+    let out = net.denoise(x, sigma, Some(cond), Some(Tensor::zeros([3, 2], &device())));
+    assert_eq!(out.dims(), [3, 1, 32, 32]);
+    assert!(values(out).iter().all(|v| v.is_finite()));
+    assert!(net.parameters() > 1000);
+}
+
+#[test]
+fn the_core_network_is_sized_for_this_cpu() {
+    let net = UNet::new(&UNetConfig::core(), 0, &device());
+    let params = net.parameters();
+    let macs = net.macs_per_pixel();
+    assert!((200_000..1_500_000).contains(&params), "{params} parameters");
+    assert!((100_000.0..600_000.0).contains(&macs), "{macs} MACs per pixel");
+}
+
+#[test]
+fn magnitude_preserving_layers_keep_unit_variance() {
+    let dev = device();
+    let mut rng = HostRng::keyed(5, 0, 0, 0);
+    let x = randn([4, 32, 24, 24], 7);
+    // 1×1 conv: exactly variance-preserving in expectation.
+    let conv1 = MpConv::new(32, 48, 1, &mut rng, &dev);
+    let y = std_of(conv1.forward(x.clone()));
+    assert!((y - 1.0).abs() < 0.1, "1×1 MP conv std {y}");
+    // 3×3 conv: zero padding loses a little at the borders only.
+    let conv3 = MpConv::new(32, 32, 3, &mut rng, &dev);
+    let y = std_of(conv3.forward(x.clone()));
+    assert!((y - 1.0).abs() < 0.12, "3×3 MP conv std {y}");
+    let lin = MpLinear::new(64, 40, &mut rng, &dev);
+    let y = std_of(lin.forward(randn([256, 64], 8)));
+    assert!((y - 1.0).abs() < 0.1, "MP linear std {y}");
+    let y = rms_of(mp_silu(x.clone()));
+    assert!((y - 1.0).abs() < 0.05, "MP SiLU rms {y}");
+    let y = std_of(mp_sum(x.clone(), randn([4, 32, 24, 24], 9), 0.3));
+    assert!((y - 1.0).abs() < 0.05, "MP sum std {y}");
+    let y = std_of(mp_cat(x.clone(), randn([4, 8, 24, 24], 10), 0.5));
+    assert!((y - 1.0).abs() < 0.05, "MP cat std {y}");
+    let y = rms_of(pixel_norm(x.mul_scalar(7.0)));
+    assert!((y - 1.0).abs() < 0.01, "pixel norm rms {y}");
+}
+
+#[test]
+fn forced_normalisation_resets_rows_to_unit_rms() {
+    let mut rng = HostRng::keyed(3, 0, 0, 0);
+    let conv = MpConv::new(4, 6, 3, &mut rng, &device());
+    let grown = MpConv { weight: conv.weight.clone().map(|w| w.mul_scalar(5.0)) };
+    let fixed = force_normalize(grown);
+    let w = values(fixed.weight.val());
+    for row in w.chunks(4 * 9) {
+        let rms = (row.iter().map(|v| v * v).sum::<f32>() / row.len() as f32).sqrt();
+        assert!((rms - 1.0).abs() < 1e-3, "row rms {rms}");
+    }
+    assert_eq!(fixed.weight.id, conv.weight.id, "forced normalisation keeps the parameter's identity");
+}
+
+#[test]
+fn an_untrained_denoiser_is_its_skip_connection() {
+    // out_gain starts at 0, so D(x; σ) = c_skip·x exactly.
+    let net = UNet::new(&UNetConfig::tiny(), 2, &device());
+    let x = randn([2, 1, 16, 16], 3);
+    let sigma = 2.0f32;
+    let out = net.denoise(
+        x.clone(),
+        Tensor::from_data(TensorData::new(vec![sigma; 2], [2]), &device()),
+        Some(randn([2, 1, 16, 16], 4)),
+        None,
+    );
+    let c_skip = 0.25 / (sigma * sigma + 0.25);
+    for (o, i) in values(out).iter().zip(values(x)) {
+        assert!((o - c_skip * i).abs() < 1e-6);
+    }
+}
+
+fn fixed_inputs(b: usize) -> (Vec<Tensor<4>>, Tensor<4>, Tensor<2>) {
+    let noise = (0..3).map(|k| randn([b, 1, 16, 16], 20 + k)).collect();
+    (noise, randn([b, 1, 16, 16], 30), Tensor::zeros([b, 2], &device()))
+}
+
+/// A tiny network with non-trivial output (the default has out_gain = 0).
+fn perturbed_tiny(seed: u64) -> UNet {
+    let mut net = UNet::new(&UNetConfig::tiny(), seed, &device());
+    net.out_gain = net.out_gain.map(|g| g.add_scalar(0.7));
+    for b in net.enc.iter_mut().chain(net.dec.iter_mut()) {
+        b.emb_gain = b.emb_gain.clone().map(|g| g.add_scalar(0.3));
+    }
+    net
+}
+
+#[test]
+fn the_sampler_is_deterministic_for_fixed_noise() {
+    let net = perturbed_tiny(4);
+    let (noise, cond, vector) = fixed_inputs(2);
+    for kind in [SamplerKind::Euler, SamplerKind::Renoise] {
+        let sampler = Sampler::karras(kind, 3, 0.05, 40.0, 7.0);
+        let a = values(sampler.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
+        let b = values(sampler.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
+        assert_eq!(a, b, "{kind:?}");
+        assert!(a.iter().all(|v| v.is_finite()));
+    }
+    let s = Sampler::karras(SamplerKind::Euler, 4, 0.002, 80.0, 7.0);
+    assert_eq!(s.sigmas.len(), 4);
+    assert!((s.sigmas[0] - 80.0).abs() < 1e-3 && (s.sigmas[3] - 0.002).abs() < 1e-5);
+    assert!(s.validate().is_ok());
+}
+
+fn manifest_for(net: &UNet) -> ModelManifest {
+    ModelManifest::new("test", net.config.clone(), Sampler::karras(SamplerKind::Renoise, 2, 0.3, 40.0, 7.0))
+}
+
+#[test]
+fn save_then_load_gives_bit_identical_outputs() {
+    let dir = tempdir("roundtrip");
+    let net = perturbed_tiny(6);
+    let written = save_model(&dir, &net, manifest_for(&net), Precision::F32).expect("save");
+    assert_eq!(written.parameters, net.parameters());
+    let loaded = load_model(&dir, "test", &device()).expect("load");
+    assert_eq!(loaded.manifest, written);
+    let (noise, cond, vector) = fixed_inputs(2);
+    let sampler = &written.sampler;
+    let a = values(sampler.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
+    let b = values(sampler.sample(&loaded.net, &noise, Some(cond), Some(vector)));
+    assert_eq!(a, b);
+
+    // f16 halves the file and stays close.
+    let half_dir = dir.join("half");
+    let half = save_model(&half_dir, &net, manifest_for(&net), Precision::F16).expect("save f16");
+    assert!(half.weights_bytes * 10 < written.weights_bytes * 6, "{} vs {}", half.weights_bytes, written.weights_bytes);
+    let loaded = load_model(&half_dir, "test", &device()).expect("load f16");
+    let (noise, cond, vector) = fixed_inputs(2);
+    let c = values(sampler.sample(&loaded.net, &noise, Some(cond), Some(vector)));
+    let worst = a.iter().zip(&c).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);
+    assert!(worst < 0.05, "f16 weights moved outputs by {worst}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn missing_or_corrupt_weights_name_the_file_and_the_command() {
+    let dir = tempdir("corrupt");
+    let err = load_model(&dir, "core", &device()).expect_err("nothing there");
+    let msg = err.to_string();
+    assert!(msg.contains("core.json") && msg.contains("infiniterra train core"), "{msg}");
+
+    let net = UNet::new(&UNetConfig::tiny(), 1, &device());
+    save_model(&dir, &net, manifest_for(&net), Precision::F32).expect("save");
+    let weights = dir.join("test.safetensors");
+    let mut bytes = std::fs::read(&weights).expect("read back");
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x5a;
+    std::fs::write(&weights, &bytes).expect("write");
+    let msg = load_model(&dir, "test", &device()).expect_err("flipped byte").to_string();
+    assert!(
+        msg.contains("test.safetensors") && msg.contains("SHA-256") && msg.contains("infiniterra train test"),
+        "{msg}"
+    );
+
+    std::fs::remove_file(&weights).expect("remove");
+    let msg = load_model(&dir, "test", &device()).expect_err("no weights").to_string();
+    assert!(msg.contains("test.safetensors") && msg.contains("missing"), "{msg}");
+
+    std::fs::write(dir.join("test.json"), "{ not json").expect("write");
+    let msg = load_model(&dir, "test", &device()).expect_err("bad manifest").to_string();
+    assert!(msg.contains("test.json") && msg.contains("not a model manifest"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_few_adam_steps_reduce_the_loss_on_a_fixed_batch() {
+    let dev = device().autodiff();
+    let mut net = UNet::new(&UNetConfig::tiny(), 9, &dev);
+    let mut optim = AdamConfig::new().with_beta_2(0.99).init();
+    let mut rng = HostRng::keyed(1, 0, 0, 0);
+    let b = 4;
+    let clean: Vec<f32> = (0..b * 256).map(|i| 0.5 * ((i % 16) as f32 * 0.7).sin()).collect();
+    let noise = rng.normals(b * 256);
+    let sigma = vec![0.3f32, 0.6, 1.0, 2.0];
+    let make = |v: &Vec<f32>| Tensor::<4>::from_data(TensorData::new(v.clone(), [b, 1, 16, 16]), &dev);
+    let cond = Tensor::<4>::zeros([b, 1, 16, 16], &dev);
+    let mut losses = Vec::new();
+    for _ in 0..20 {
+        let loss = edm_loss(&net, make(&clean), make(&noise), &sigma, Some(cond.clone()), None);
+        losses.push(values(loss.clone().inner())[0]);
+        let grads = GradientsParams::from_grads(loss.backward(), &net);
+        net = force_normalize(optim.step(2e-2, net, grads));
+    }
+    assert!(losses[19] < 0.8 * losses[0], "losses {losses:?}");
+}
+
+fn tempdir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("infiniterra-model-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// A smooth, deterministic coarse field (metres) standing in for the coarse stage.
+struct Hills;
+
+impl Source for Hills {
+    fn channels(&self) -> usize {
+        1
+    }
+    fn query(&self, rect: Rect) -> Tile {
+        let mut data = Vec::with_capacity(rect.area());
+        for y in rect.y0..rect.y1() {
+            for x in rect.x0..rect.x1() {
+                data.push(800.0 * ((y as f32) * 0.3).sin() * ((x as f32) * 0.2).cos() + 300.0);
+            }
+        }
+        Tile::from_data(1, rect, data)
+    }
+}
+
+fn tiny_core(batch: usize) -> CoreStage {
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    manifest.normalisation =
+        Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+    CoreStage::new(LoadedModel { net, manifest }, device(), Arc::new(Hills), 42, batch)
+}
+
+#[test]
+fn the_core_stage_is_seed_consistent_through_the_engine() {
+    let region = Rect::new(-40, 25, 48, 40);
+    let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 });
+    let whole = Windowed::new(&engine, tiny_core(4)).query(region);
+    assert!(whole.data.iter().all(|v| v.is_finite()));
+    // Another engine, other batch size, one thread, piecewise queries: same values.
+    let engine = Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 });
+    let tensor = Windowed::new(&engine, tiny_core(3));
+    let part = tensor.query(Rect::new(-20, 40, 16, 16));
+    assert_eq!(whole.crop(part.rect), part);
+    assert_eq!(tensor.query(region), whole);
+}
+
+/// Speed of the core network on this machine: network evaluations of 64×64 windows per
+/// second by batch size, and the core stage through the engine (2 threads) on a 256² region.
+#[test]
+#[ignore = "benchmark: cargo test -p infiniterra-terrain bench_core -- --ignored --nocapture"]
+fn bench_core_windows_per_second() {
+    let net = UNet::new(&UNetConfig::core(), 0, &device());
+    let flop = 2.0 * net.macs_per_pixel() * 64.0 * 64.0;
+    for batch in [1usize, 4, 8, 16] {
+        let x = randn([batch, 1, 64, 64], 1);
+        let cond = randn([batch, 1, 64, 64], 2);
+        let sigma = Tensor::<1>::from_data(TensorData::new(vec![1.0f32; batch], [batch]), &device());
+        let run = || values(net.denoise(x.clone(), sigma.clone(), Some(cond.clone()), None));
+        run();
+        let reps = (32 / batch).max(2);
+        let t = std::time::Instant::now();
+        for _ in 0..reps {
+            run();
+        }
+        let secs = t.elapsed().as_secs_f64();
+        let wps = (reps * batch) as f64 / secs;
+        println!("batch {batch:2}: {wps:6.1} windows/s per network evaluation, {:.1} GFLOP/s", wps * flop / 1e9);
+    }
+    for steps in [1usize, 2, 4] {
+        let mut manifest = manifest_for(&net);
+        manifest.sampler = Sampler::karras(SamplerKind::Euler, steps, 0.05, 80.0, 7.0);
+        manifest.normalisation =
+            Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+        let model = LoadedModel { net: UNet::new(&UNetConfig::core(), 0, &device()), manifest };
+        let engine = Engine::new(EngineConfig { cache_bytes: 256 << 20, threads: 2 });
+        let tensor = Windowed::new(&engine, CoreStage::new(model, device(), Arc::new(Hills), 1, 8));
+        let t = std::time::Instant::now();
+        let _ = tensor.query(Rect::new(0, 0, 256, 256));
+        let secs = t.elapsed().as_secs_f64();
+        let windows = tensor.evaluations();
+        println!(
+            "core stage, {steps}-step sampler, 256² region: {windows} windows in {secs:.2} s = {:.1} windows/s, {:.0} px/s",
+            windows as f64 / secs,
+            65536.0 / secs
+        );
+    }
+}
