@@ -25,8 +25,8 @@ use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
 use infiniterra_terrain::model::{
-    edm_loss, force_normalize, save_model, ComputeBackend, ModelManifest, NoiseDistribution, Normalisation, Precision,
-    Sampler, SamplerKind, TrainingRecord, UNet, UNetConfig,
+    edm_loss, force_normalize, save_model, ComputeBackend, DataChecksum, ModelManifest, NoiseDistribution,
+    Normalisation, Precision, Sampler, SamplerKind, TrainingRecord, UNet, UNetConfig,
 };
 use serde::{Deserialize, Serialize};
 
@@ -504,7 +504,37 @@ impl Trainer {
             final_loss: self.state.losses.last().map_or(f32::NAN, |l| l.1),
             wall_seconds: self.state.wall_seconds,
         };
-        manifest.data = self.train.checksums.iter().chain(&self.heldout.checksums).cloned().collect();
+        // Paths relative to the working directory when they lie below it, so the manifest
+        // reads the same on every checkout.
+        let cwd = std::env::current_dir().unwrap_or_default();
+        manifest.data = self
+            .train
+            .checksums
+            .iter()
+            .chain(&self.heldout.checksums)
+            .map(|c| {
+                let file = Path::new(&c.file).strip_prefix(&cwd).map_or(c.file.clone(), |p| p.display().to_string());
+                DataChecksum { file, sha256: c.sha256.clone() }
+            })
+            .collect();
+        // The command that reproduces these exact weights (a --minutes run stops at a
+        // machine-dependent step; this names the step it reached).
+        let s = &self.state;
+        manifest.recreate = format!(
+            "infiniterra train {} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {} --precision {}",
+            s.stage,
+            s.step,
+            s.seed,
+            s.batch,
+            s.crop,
+            s.lr,
+            s.lr_ref_steps,
+            s.ema,
+            match self.args.precision {
+                Precision::F16 => "f16",
+                Precision::F32 => "f32",
+            }
+        );
         if let Some(&(_, v)) = self.state.validation.last() {
             manifest.realism.insert("validation_edm_loss".into(), v as f64);
         }
