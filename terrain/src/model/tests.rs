@@ -276,7 +276,7 @@ fn the_core_stage_is_seed_consistent_through_the_engine() {
 /// Speed of the core network on this machine: network evaluations of 64×64 windows per
 /// second by batch size, and the core stage through the engine (2 threads) on a 256² region.
 #[test]
-#[ignore = "benchmark: cargo test -p infiniterra-terrain bench_core -- --ignored --nocapture"]
+#[ignore = "benchmark: cargo test -p infiniterra-terrain --features learned bench_core -- --ignored --nocapture"]
 fn bench_core_windows_per_second() {
     let net = UNet::new(&UNetConfig::core(), 0, &device());
     let flop = 2.0 * net.macs_per_pixel() * 64.0 * 64.0;
