@@ -18,7 +18,7 @@
 // chunks) of the player's chunk. Prints one JSON line; exit code 0 with {"ok":true,...}, 1 with
 // {"ok":false,"error":...}. Every wait is for a packet or a condition, bounded by the timeout.
 
-const mineflayer = require('mineflayer')
+const { createBot } = require('./bot')
 
 function parseArgs (argv) {
   const args = { port: Number(argv[0]), name: 'flyer', view: 4, cap: 32, distance: 500, speed: 25, timeout: 120 }
@@ -52,15 +52,7 @@ function view (cx, cz, dist) {
 function fly (args) {
   return new Promise(resolve => {
     const started = Date.now()
-    const bot = mineflayer.createBot({
-      host: '127.0.0.1',
-      port: args.port,
-      username: args.name,
-      version: '1.20.1',
-      auth: 'offline',
-      viewDistance: args.view,
-      hideErrors: true
-    })
+    const bot = createBot(args.port, args.name, args.view)
     const dist = Math.min(args.view, args.cap)
     const report = { ok: false, name: args.name, view: dist }
     const loaded = new Set() // chunks the client holds now

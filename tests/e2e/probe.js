@@ -8,7 +8,7 @@
 // Exit code 0 with {"ok":true,...}; 1 with {"ok":false,"error":...} on a kick, an error or
 // the timeout. Every wait is for an event or a condition, bounded by the timeout.
 
-const mineflayer = require('mineflayer')
+const { createBot } = require('./bot')
 const { Vec3 } = require('vec3')
 
 function parseArgs (argv) {
@@ -37,15 +37,7 @@ function finish (bot, code, report) {
 function main () {
   const args = parseArgs(process.argv.slice(2))
   const started = Date.now()
-  const bot = mineflayer.createBot({
-    host: '127.0.0.1',
-    port: args.port,
-    username: args.name,
-    version: '1.20.1',
-    auth: 'offline',
-    viewDistance: args.view,
-    hideErrors: true
-  })
+  const bot = createBot(args.port, args.name, args.view)
   const report = { ok: false, name: args.name }
   const chunks = new Set()
   const lit = new Map() // chunk → its latest light packet (the server sends it after the chunk)
