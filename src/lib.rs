@@ -12,9 +12,11 @@ pub mod config;
 pub mod eval;
 pub mod export;
 pub mod fill;
+pub mod pregen;
 pub mod render;
 pub mod server;
 #[cfg(feature = "learned")]
 pub mod train;
+pub mod world;
 
 pub use infiniterra_terrain as terrain;

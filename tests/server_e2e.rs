@@ -58,15 +58,22 @@ struct Server {
 }
 
 impl Server {
-    /// Starts `infiniterra serve` on a free loopback port with rules from `biomes`, and waits
-    /// for "listening on".
+    /// Starts `infiniterra serve` on a free loopback port with rules from `biomes`, saving to a
+    /// fresh world folder, and waits for "listening on".
     fn start(biomes: &Path, seed: u64) -> Server {
         let dir = tempfile::tempdir().expect("temp dir");
+        let world = dir.path().join("world");
+        Server::start_with(biomes, seed, dir, &format!("directory = {:?}\n", world.display().to_string()))
+    }
+
+    /// Starts the server with `world` appended to the `[world]` table of its configuration;
+    /// `dir` holds the configuration and lives as long as the server.
+    fn start_with(biomes: &Path, seed: u64, dir: tempfile::TempDir, world: &str) -> Server {
         let port = free_port();
         let config_path = dir.path().join("server.toml");
         let text = format!(
             "[server]\nbind = \"127.0.0.1:{port}\"\nview_distance_cap = {VIEW}\nchunk_threads = 2\nchunk_cache = 512\n\n\
-             [world]\nseed = {seed}\n"
+             [world]\nseed = {seed}\n{world}"
         );
         std::fs::write(&config_path, text).expect("write config");
         let config = Config::load(&config_path).expect("test config loads");
@@ -319,7 +326,9 @@ fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
     let dir = tempfile::tempdir().expect("temp dir");
     let biomes = dir.path().join("biomes");
     copy_dir(&repo().join("biomes"), &biomes);
-    let mut server = Server::start(&biomes, 3);
+    // Saved chunks keep the rules they were made with; with saving off, a revisited place is
+    // generated again and so follows the new rules, which is what this test looks at.
+    let mut server = Server::start_with(&biomes, 3, tempfile::tempdir().expect("temp dir"), "save_chunks = false\n");
     let generator = generator(&server.config);
     let rules = load_rules(&biomes);
     let spawn = find_spawn(&generator, &rules);
@@ -487,5 +496,162 @@ fn twenty_players_joining_and_leaving_repeatedly_leave_no_chunks_behind() {
     // Still serving: one more player joins, and the process is alive.
     server.probe("after_churn", &[]);
     assert!(server.child.try_wait().expect("process state").is_none(), "the server exited");
+    assert!(server.stop().success());
+}
+
+/// A world folder outside the server's own temporary folder, so a second server can reuse it.
+fn world_config(world: &Path) -> String {
+    format!("directory = {:?}\n", world.display().to_string())
+}
+
+/// Runs `infiniterra pregen` (the batch command) around `center`.
+fn batch_pregen(config: &Config, world: &Path, center: (i64, i64), radius: i64) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let config_path = dir.path().join("server.toml");
+    std::fs::write(&config_path, format!("[world]\nseed = {}\n", config.world.seed)).expect("write config");
+    let out = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
+        .arg("pregen")
+        .arg("--config")
+        .arg(&config_path)
+        .arg("--world")
+        .arg(world)
+        .args(["--center", &format!("{},{}", center.0, center.1), "--radius", &radius.to_string()])
+        .arg("--biomes")
+        .arg(repo().join("biomes"))
+        .output()
+        .expect("run infiniterra pregen");
+    assert!(out.status.success(), "pregen: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+#[test]
+fn a_corrupt_saved_chunk_is_reported_and_served_regenerated() {
+    use infiniterra::world::region::{local, RegionFile, RegionPos};
+    let seed = 6;
+    let keep = tempfile::tempdir().expect("temp dir");
+    let world = keep.path().join("world");
+    let mut config = Config::default();
+    config.world.seed = seed;
+    let rules = load_rules(&repo().join("biomes"));
+    let generator = generator(&config);
+    let spawn = find_spawn(&generator, &rules);
+    let (sx, sz) = (i64::from(spawn.block.x), i64::from(spawn.block.z));
+    batch_pregen(&config, &world, (sx, sz), 96);
+
+    // Garbage over the compressed bytes of the spawn chunk, length and header left alone.
+    let (cx, cz) = (spawn.block.x.div_euclid(16), spawn.block.z.div_euclid(16));
+    let path = world.join("region").join(RegionPos::of_chunk(cx, cz).file_name());
+    let (lx, lz) = local(cx, cz);
+    let original = RegionFile::open(&path, false).expect("open").read(lx, lz).expect("readable").expect("saved");
+    let mut bytes = std::fs::read(&path).expect("read region");
+    let entry = 4 * (lx + lz * 32);
+    let sector = u32::from_be_bytes(bytes[entry..entry + 4].try_into().expect("4 bytes")) >> 8;
+    let data = sector as usize * 4096 + 5;
+    bytes[data..data + 200].fill(0xAB);
+    std::fs::write(&path, &bytes).expect("write region");
+    assert!(RegionFile::open(&path, false).expect("open").read(lx, lz).is_err(), "the chunk still reads");
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut server = Server::start_with(&repo().join("biomes"), seed, dir, &world_config(&world));
+    let columns: Vec<(i64, i64)> = (0..16).map(|i| (cx as i64 * 16 + i, cz as i64 * 16 + 15 - i)).collect();
+    let list = columns.iter().map(|(x, z)| format!("{x},{z}")).collect::<Vec<_>>().join(";");
+    let report = server.probe("inspector", &["--columns".into(), list]);
+    let line = server.expect_line(|l| l.starts_with("corrupt chunk"), LINE_TIMEOUT);
+    assert!(line.starts_with(&format!("corrupt chunk {cx}, {cz}:")) && line.contains("regenerated"), "{line}");
+    assert!(line.contains(&RegionPos::of_chunk(cx, cz).file_name()), "{line}");
+    let v = *generator.vertical();
+    for (c, &(x, z)) in report["columns"].as_array().expect("columns").iter().zip(&columns) {
+        let s = generator.surface(&rules, x, z);
+        let expected_y = if s.y >= v.water_top_y() { s.y } else { v.water_top_y() };
+        assert_eq!(c["y"].as_i64(), Some(i64::from(expected_y)), "column ({x}, {z}): {c}");
+        if s.y >= v.water_top_y() {
+            assert_eq!(c["block"], s.top, "ground block of ({x}, {z})");
+        }
+    }
+    assert!(server.stop().success());
+    // The regenerated chunk was saved over the broken one, identical to the original.
+    let repaired = RegionFile::open(&path, false).expect("open").read(lx, lz).expect("readable").expect("saved");
+    assert!(repaired == original, "the regenerated chunk differs from the one first saved");
+}
+
+#[test]
+fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_restart() {
+    use infiniterra::pregen::{Plan, Progress, Shape, Shard, State, Task};
+    use infiniterra::world::region::{local, RegionFile, RegionPos};
+    let seed = 9;
+    let keep = tempfile::tempdir().expect("temp dir");
+    let world = keep.path().join("world");
+    let biomes = repo().join("biomes");
+    let mut server = Server::start_with(&biomes, seed, tempfile::tempdir().expect("temp dir"), &world_config(&world));
+    let pregen_line = |l: &str| l.starts_with("pregen");
+
+    server.command("pregen progress");
+    assert_eq!(server.expect_line(pregen_line, LINE_TIMEOUT), "pregen: no task");
+    server.command("pregen start 0 0 lots");
+    let line = server.expect_line(pregen_line, LINE_TIMEOUT);
+    assert!(line.contains("radius \"lots\" is not a whole number"), "{line}");
+
+    // A small task runs to the end, and every chunk of it is in the region files.
+    server.command("pregen start 40 -40 100 circle");
+    let line = server.expect_line(pregen_line, LINE_TIMEOUT);
+    assert!(line.starts_with("pregen: circle of radius 100 around 40, -40:"), "{line}");
+    let finished = server.expect_line(|l| l.starts_with("pregen:") && l.contains("finished"), START_TIMEOUT);
+    let small = Plan::new(Task { center_x: 40, center_z: -40, radius: 100, shape: Shape::Circle }, Shard::ALL);
+    assert!(finished.contains(&format!("{}/{} chunks (100.0%)", small.total(), small.total())), "{finished}");
+    for i in 0..small.regions().len() {
+        for (x, z) in small.region_chunks(i) {
+            let path = world.join("region").join(RegionPos::of_chunk(x, z).file_name());
+            let (lx, lz) = local(x, z);
+            assert!(RegionFile::open(&path, false).expect("region").contains(lx, lz), "chunk {x}, {z} not saved");
+        }
+    }
+
+    // A big task: players still get their chunks while it runs; pause, continue, cancel.
+    server.command("pregen start 0 0 3000");
+    server.expect_line(|l| l.starts_with("pregen: square of radius 3000"), LINE_TIMEOUT);
+    let expected_chunks = ChunkView::new(ChunkPos::new(0, 0), VIEW).iter().count();
+    let report = server.probe("visitor", &["--expect-chunks".into(), expected_chunks.to_string()]);
+    assert!(report["all_chunks_ms"].as_f64().is_some(), "the player's view did not arrive: {report}");
+    server.command("pregen pause");
+    assert_eq!(server.expect_line(pregen_line, LINE_TIMEOUT), "pregen: paused; `pregen continue` resumes");
+    server.command("pregen progress");
+    let line = server.expect_line(pregen_line, LINE_TIMEOUT);
+    assert!(line.contains("paused") && line.contains("chunks ("), "{line}");
+    server.command("pregen continue");
+    assert_eq!(server.expect_line(pregen_line, LINE_TIMEOUT), "pregen: continuing");
+    server.command("pregen cancel");
+    let line = server.expect_line(pregen_line, LINE_TIMEOUT);
+    assert!(line.contains("Type `pregen confirm`"), "{line}");
+    server.command("seed"); // Any other command keeps the task.
+    server.command("pregen confirm");
+    assert_eq!(server.expect_line(pregen_line, LINE_TIMEOUT), "pregen: nothing to confirm (`pregen cancel` first)");
+    server.command("pregen cancel");
+    server.expect_line(|l| l.contains("Type `pregen confirm`"), LINE_TIMEOUT);
+    server.command("pregen confirm");
+    server.expect_line(|l| l == "pregen: cancelled", LINE_TIMEOUT);
+    assert!(!world.join("pregen.json").exists(), "a cancelled task leaves its progress file");
+
+    // A running task survives a restart: the next server resumes it where it was saved.
+    server.command("pregen start 0 0 3000");
+    server.expect_line(|l| l.starts_with("pregen: square of radius 3000"), LINE_TIMEOUT);
+    server.expect_line(|l| l.starts_with("pregen: ") && l.contains(" chunks (") && l.contains("ETA"), START_TIMEOUT);
+    assert!(server.stop().success());
+    let saved = Progress::load(&world.join("pregen.json")).expect("progress").expect("saved at stop");
+    assert_eq!(saved.state, State::Running);
+    assert!(saved.done > 0, "{saved:?}");
+    let mut server = Server::start_with(&biomes, seed, tempfile::tempdir().expect("temp dir"), &world_config(&world));
+    // (It said "resuming" during start-up; the task is active again, from where it was saved.)
+    server.command("pregen progress");
+    let line = server.expect_line(|l| l == "pregen: no task" || l.contains(" chunks ("), LINE_TIMEOUT);
+    let done: u64 = line
+        .strip_prefix("pregen: ")
+        .and_then(|l| l.split('/').next())
+        .map(|n| n.replace(',', ""))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no progress in {line:?}"));
+    assert!(done >= saved.done, "resumed at {done}, saved {}: {line}", saved.done);
+    server.command("pregen cancel");
+    server.expect_line(|l| l.contains("Type `pregen confirm`"), LINE_TIMEOUT);
+    server.command("pregen confirm");
+    server.expect_line(|l| l == "pregen: cancelled", LINE_TIMEOUT);
     assert!(server.stop().success());
 }

@@ -1,11 +1,14 @@
 //! `infiniterra bench`: numbers for this machine — the engine's own overhead per window
-//! with a trivial Φ, and the pipeline's throughput for the stages that exist.
+//! with a trivial Φ, the pipeline's throughput, and pre-generation and joining the whole way
+//! to region files (chunks/s, first region cold, join latency, peak memory), as a table, as
+//! JSON and as a PNG chart against the goals.
 //!
 //! Every figure is the median of several runs at different places of the world (fresh
 //! pipelines, so "cold" really is cold). Speed targets live here, never in timed tests.
 
 mod engine;
 mod pipeline;
+mod pregen;
 
 use clap::Args;
 use serde::Serialize;
@@ -21,6 +24,12 @@ pub struct BenchArgs {
     /// Runs per measurement (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub runs: usize,
+    /// Chunks in the long pre-generation run (throughput and peak memory); 0 skips it.
+    #[arg(long, default_value_t = 20_000)]
+    pub pregen_chunks: u64,
+    /// Where to write the chart.
+    #[arg(long, default_value = "bench.png")]
+    pub out: std::path::PathBuf,
 }
 
 /// One measured quantity.
@@ -53,6 +62,7 @@ pub fn run(config: &Config, args: &BenchArgs) -> anyhow::Result<()> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut all = engine::measure(runs);
     all.extend(pipeline::measure(config, runs));
+    all.extend(pregen::measure(config, runs, args.pregen_chunks)?);
     if args.json {
         let doc = serde_json::json!({ "machine_threads": threads, "seed": config.world.seed, "measurements": all });
         println!("{}", serde_json::to_string_pretty(&doc)?);

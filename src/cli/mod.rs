@@ -57,12 +57,8 @@ pub enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         rest: Vec<String>,
     },
-    /// Pre-generate a region into Anvil files without a server.
-    Pregen {
-        /// Any further arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        rest: Vec<String>,
-    },
+    /// Pre-generate a region into Anvil files without a server (resumable; shardable).
+    Pregen(crate::pregen::batch::PregenArgs),
     /// Measure the engine and the pipeline on this machine.
     Bench(crate::bench::BenchArgs),
 }
@@ -142,14 +138,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             "`infiniterra train` is in this build only with the learned-model code: \
              `cargo run --release --features learned -- train STAGE` (learned terrain is issue #4, in progress)"
         ))),
-        Command::Pregen { .. } => not_yet("pregen", 6, "pre-generation and Anvil persistence"),
+        Command::Pregen(a) => crate::pregen::batch::run(&load_config(&cli)?, a),
         Command::Bench(a) => crate::bench::run(&load_config(&cli)?, a).map_err(Failure::runtime),
     }
-}
-
-/// Commands that a later issue delivers: say so and fail, never pretend.
-fn not_yet(command: &str, issue: u32, what: &str) -> Result<(), Failure> {
-    Err(Failure::runtime(anyhow::anyhow!(
-        "`infiniterra {command}` is not built yet: {what} arrives with issue #{issue}"
-    )))
 }

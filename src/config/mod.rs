@@ -100,6 +100,11 @@ pub struct WorldSettings {
     pub metres_per_block: f64,
     /// Metres of depth per block under the sea (the sea floor is compressed).
     pub sea_metres_per_block: f64,
+    /// Folder of the saved world (`level.dat`, `region/r.X.Z.mca`), relative to the current
+    /// directory unless absolute.
+    pub directory: PathBuf,
+    /// Save every generated chunk and load saved chunks instead of generating them again.
+    pub save_chunks: bool,
 }
 
 impl Default for WorldSettings {
@@ -111,6 +116,8 @@ impl Default for WorldSettings {
             height: 384,
             metres_per_block: 25.0,
             sea_metres_per_block: 60.0,
+            directory: PathBuf::from("world"),
+            save_chunks: true,
         }
     }
 }
@@ -196,6 +203,13 @@ impl Config {
             }
         }
         check_range("world.min_y + world.height", w.min_y + w.height, -2016, 2032)?;
+        if w.directory.as_os_str().is_empty() {
+            return Err(RangeError {
+                key: "world.directory".into(),
+                value: "\"\"".into(),
+                allowed: "a folder path such as \"world\"".into(),
+            });
+        }
         self.terrain().validate()
     }
 }

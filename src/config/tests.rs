@@ -14,6 +14,7 @@ fn the_shipped_config_is_valid_and_matches_the_defaults_it_documents() {
     assert_eq!(shipped.climate, ClimateSettings::default());
     assert_eq!(shipped.engine, EngineSettings::default());
     assert_eq!(shipped.server, ServerSettings::default());
+    assert_eq!(shipped.world, WorldSettings::default());
 }
 
 #[test]

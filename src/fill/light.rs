@@ -69,6 +69,23 @@ impl SkyLight {
         }
     }
 
+    /// Number of light sections: the world's sections plus one below and one above it.
+    pub fn section_count(&self) -> usize {
+        self.sections.len()
+    }
+
+    /// Light bytes of section `index` (0 is the one below the world) in the client's and
+    /// Anvil's layout (index `y·256 + z·16 + x`, low nibble first), or `None` when every
+    /// value is 0 (Anvil then omits the array). Panics when `index` is out of range.
+    pub fn section_bytes(&self, index: usize) -> Option<&[u8; SECTION_BYTES]> {
+        static FULL: [u8; SECTION_BYTES] = [0xFF; SECTION_BYTES];
+        match &self.sections[index] {
+            Section::Dark => None,
+            Section::Full => Some(&FULL),
+            Section::Mixed(bytes) => Some(bytes),
+        }
+    }
+
     /// The packet that gives a client this light for the chunk at `pos` (no block light:
     /// nothing in generated terrain glows).
     pub fn packet(&self, pos: ChunkPos) -> LightUpdateS2c {

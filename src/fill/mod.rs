@@ -20,7 +20,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use valence::prelude::{BiomeId, BiomeRegistry};
-use valence::registry::RegistryCodec;
+use valence::registry::{RegistryCodec, RegistryIdx};
 
 use crate::config::Config;
 use crate::terrain::Pipeline;
@@ -83,14 +83,38 @@ pub fn vanilla_biome_names() -> Vec<String> {
 #[derive(Clone, Debug)]
 pub struct BiomePalette {
     ids: HashMap<String, BiomeId>,
+    /// Name of each id, by index.
+    names: Vec<String>,
     fallback: BiomeId,
 }
 
 impl BiomePalette {
     /// Every biome of `registry`; unknown names map to the registry's first biome (plains).
     pub fn from_registry(registry: &BiomeRegistry) -> BiomePalette {
-        let ids = registry.iter().map(|(id, name, _)| (name.as_str().to_string(), id)).collect();
-        BiomePalette { ids, fallback: BiomeId::DEFAULT }
+        let mut names = vec![String::new(); registry.iter().count()];
+        let mut ids = HashMap::new();
+        for (id, name, _) in registry.iter() {
+            names[id.to_index()] = name.as_str().to_string();
+            ids.insert(name.as_str().to_string(), id);
+        }
+        BiomePalette { ids, names, fallback: BiomeId::DEFAULT }
+    }
+
+    /// The palette of valence's default biome registry without a running server: vanilla's
+    /// biomes in registry order with plains swapped to the front, exactly as valence's biome
+    /// plugin builds the registry the server uses.
+    pub fn vanilla() -> BiomePalette {
+        let mut names = vanilla_biome_names();
+        if let Some(i) = names.iter().position(|n| n == "minecraft:plains") {
+            names.swap(0, i);
+        }
+        let ids = names.iter().enumerate().map(|(i, n)| (n.clone(), BiomeId::from_index(i))).collect();
+        BiomePalette { ids, names, fallback: BiomeId::DEFAULT }
+    }
+
+    /// Biome names indexed by id.
+    pub fn names(&self) -> &[String] {
+        &self.names
     }
 
     /// The id of biome `name`, or the fallback when the registry lacks it.

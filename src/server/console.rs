@@ -20,7 +20,8 @@ const HELP: &str = "commands:
   status   players, chunk generation, queue, cache and memory
   reload   re-read the biome rules (on error the current rules stay)
   seed     the world seed
-  stop     disconnect everyone and stop the server";
+  stop     disconnect everyone, save and stop the server
+";
 
 #[derive(Resource)]
 struct ConsoleInput(Mutex<Receiver<String>>);
@@ -48,18 +49,32 @@ fn run_commands(
     streamer: Option<ResMut<Streamer>>,
     stop: Res<StopRequest>,
     clients: Query<&Username, With<Client>>,
+    mut pregen: ResMut<super::pregen::PregenControl>,
 ) {
     let lines: Vec<String> = input.0.lock().unwrap_or_else(PoisonError::into_inner).try_iter().collect();
     let mut streamer = streamer;
     for line in lines {
         let command = line.trim();
+        let is_pregen = command.split_whitespace().next() == Some("pregen");
+        if !is_pregen && !command.is_empty() {
+            pregen.forget_confirmation();
+        }
         match command {
             "" => {}
-            "help" => say!("{HELP}"),
+            "help" => say!("{HELP}{}", super::pregen::HELP),
             "seed" => say!("seed {}", setup.config.world.seed),
             "stop" => stop.request(),
-            "status" => print_status(streamer.as_deref_mut(), &clients),
+            "status" => {
+                print_status(streamer.as_deref_mut(), &clients);
+                if let Some(job) = pregen.job() {
+                    say!("{}", job.status().line());
+                }
+            }
             "reload" => reload(&mut setup, streamer.as_deref_mut()),
+            other if is_pregen => {
+                let words: Vec<&str> = other.split_whitespace().skip(1).collect();
+                super::pregen::command(&words, &setup, &mut pregen, streamer.as_deref());
+            }
             other => say!("unknown command {other:?}: type `help` for the list"),
         }
     }

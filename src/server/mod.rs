@@ -17,6 +17,7 @@ macro_rules! say {
 mod console;
 mod lifecycle;
 mod players;
+mod pregen;
 mod spawn;
 mod stream;
 mod world;
@@ -33,6 +34,7 @@ use crate::fill::Generator;
 use crate::terrain::Pipeline;
 
 pub use spawn::{find_spawn, SpawnPoint};
+pub use world::check_biome_names;
 
 /// Options of `infiniterra serve` beyond the configuration file.
 #[derive(Clone, Debug)]
@@ -77,6 +79,19 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
     say!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
     let spawn = find_spawn(&generator, &rules);
     say!("spawn point: x {} y {} z {}", spawn.block.x, spawn.block.y, spawn.block.z);
+    let store = if config.world.save_chunks {
+        let dir = &config.world.directory;
+        let at = [spawn.block.x, spawn.block.y, spawn.block.z];
+        crate::world::prepare(dir, config.world.seed, at, crate::pregen::batch::game_type(config))
+            .map_err(ServeError::Input)?;
+        let store = crate::world::Store::open(dir)
+            .map_err(|e| ServeError::Runtime(anyhow::anyhow!("cannot start the region writer: {e}")))?;
+        say!("saving the world to {}", dir.display());
+        Some(Arc::new(store))
+    } else {
+        None
+    };
+    let pregen = pregen::PregenControl::default();
 
     let exit = lifecycle::ExitCode::default();
     let mut app = App::new();
@@ -96,6 +111,7 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
         generator,
         rules: Arc::new(rules),
         biomes_dir: options.biomes_dir.clone(),
+        store: store.clone(),
     })
     .insert_resource(spawn)
     .insert_resource(exit.clone());
@@ -103,8 +119,20 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
     players::build(&mut app, config);
     stream::build(&mut app);
     console::build(&mut app);
+    pregen::build(&mut app, pregen.clone());
     lifecycle::build(&mut app, address).map_err(ServeError::Runtime)?;
     app.run();
+    // Save before exiting: the task records where it is (a running one resumes at the next
+    // start), then every queued chunk is written and fsynced.
+    if let Some(job) = pregen.job() {
+        job.stop();
+    }
+    if let Some(store) = store {
+        if let Err(e) = store.close() {
+            tracing::error!("saving the world: {e}");
+            return Err(ServeError::Runtime(anyhow::anyhow!("saving the world: {e}")));
+        }
+    }
     exit.result()
 }
 

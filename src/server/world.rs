@@ -9,6 +9,7 @@ use valence::prelude::*;
 use crate::biome::BiomeRules;
 use crate::config::Config;
 use crate::fill::{vanilla_biome_names, BiomePalette, Generator};
+use crate::world::Store;
 
 /// What start-up hands the app: configuration, generator and the biome rules.
 #[derive(Resource)]
@@ -21,6 +22,8 @@ pub struct WorldSetup {
     pub rules: Arc<BiomeRules>,
     /// Where `reload` reads rules from.
     pub biomes_dir: PathBuf,
+    /// The saved world's region files (`None` when `world.save_chunks` is off).
+    pub store: Option<Arc<Store>>,
 }
 
 /// Biome names → client ids, fixed at start-up (every vanilla biome is registered, so any

@@ -9,6 +9,8 @@ mod cache;
 mod tests;
 mod workers;
 
+pub use workers::Waker;
+
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::mpsc;
 use std::sync::Arc;
@@ -24,6 +26,8 @@ use self::workers::{Built, Finished, Results, Workers};
 use super::players::PlayersSet;
 use super::world::{Palette, WorldSetup};
 use crate::biome::BiomeRules;
+use crate::pregen::Job;
+use crate::world::ChunkSource;
 
 /// How far back "chunks generated per second" looks.
 const RATE_WINDOW: Duration = Duration::from_secs(10);
@@ -111,6 +115,16 @@ impl Streamer {
         self.dirty = true;
     }
 
+    /// Workers take chunks of `job` whenever no player chunk waits (`None`: stop doing so).
+    pub fn set_pregen(&self, job: Option<Arc<Job>>) {
+        self.workers.set_pregen(job);
+    }
+
+    /// Wakes idle workers from any thread (a pre-generation task resumed).
+    pub fn waker(&self) -> Waker {
+        self.workers.waker()
+    }
+
     fn trim_recent(&mut self) {
         let now = Instant::now();
         while self.stats.recent.front().is_some_and(|t| now.duration_since(*t) > RATE_WINDOW) {
@@ -136,8 +150,8 @@ fn start_workers(
 ) {
     let (done, results) = mpsc::channel();
     let threads = setup.config.server.chunk_threads as usize;
-    let (generator, palette, rules) = (setup.generator.clone(), palette.0.clone(), setup.rules.clone());
-    match Workers::start(threads, generator, palette, rules, server.compression_threshold(), done) {
+    let source = Arc::new(ChunkSource::new(setup.generator.clone(), palette.0.clone(), setup.store.clone()));
+    match Workers::start(threads, source, setup.rules.clone(), server.compression_threshold(), done) {
         Ok(workers) => commands.insert_resource(Streamer {
             workers,
             results: Results::new(results),

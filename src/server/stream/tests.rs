@@ -55,7 +55,13 @@ fn app() -> (App, Entity) {
     let mut app = App::new();
     app.insert_resource(KeepaliveSettings { period: Duration::MAX })
         .add_plugins(DefaultPlugins.build().disable::<NetworkPlugin>().disable::<valence::log::LogPlugin>())
-        .insert_resource(WorldSetup { config, generator, rules: Arc::new(rules), biomes_dir: PathBuf::new() })
+        .insert_resource(WorldSetup {
+            config,
+            generator,
+            rules: Arc::new(rules),
+            biomes_dir: PathBuf::new(),
+            store: None,
+        })
         .add_systems(Update, despawn_disconnected_clients);
     world::build(&mut app);
     super::build(&mut app);

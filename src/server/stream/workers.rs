@@ -1,4 +1,6 @@
-//! Chunk workers: threads that take the nearest wanted chunk, build it, and hand it back.
+//! Chunk workers: threads that take the nearest wanted chunk, build it (or load it from the
+//! saved world), and hand it back. With no player chunk waiting, they work on the console's
+//! pre-generation task, so players' chunks always come first.
 //!
 //! The main thread owns the wish list and rewrites it whenever views change, so a chunk that
 //! is no longer wanted is simply gone from the list before any worker starts it (cancelled
@@ -16,7 +18,8 @@ use valence::prelude::{ChunkPos, UnloadedChunk};
 use valence::protocol::{CompressionThreshold, PacketEncoder};
 
 use crate::biome::BiomeRules;
-use crate::fill::{BiomePalette, Generator, SkyLight};
+use crate::pregen::{self, Job};
+use crate::world::{ChunkSource, Origin, Scratch};
 
 /// A chunk ready to insert, with its sky light as a ready-to-send packet.
 pub struct Built {
@@ -44,6 +47,8 @@ struct Queue {
     in_flight: HashSet<ChunkPos>,
     rules: Arc<BiomeRules>,
     generation: u64,
+    /// The pre-generation task worked on when no player chunk waits.
+    pregen: Option<Arc<Job>>,
     shutdown: bool,
 }
 
@@ -67,12 +72,11 @@ pub struct Workers {
 }
 
 impl Workers {
-    /// Starts `threads` workers building chunks with `generator` and `rules`, sending results
-    /// to `done`.
+    /// Starts `threads` workers getting chunks from `source` with `rules`, sending results to
+    /// `done`.
     pub fn start(
         threads: usize,
-        generator: Arc<Generator>,
-        palette: Arc<BiomePalette>,
+        source: Arc<ChunkSource>,
         rules: Arc<BiomeRules>,
         compression: CompressionThreshold,
         done: Sender<Finished>,
@@ -83,16 +87,17 @@ impl Workers {
                 in_flight: HashSet::new(),
                 rules,
                 generation: 0,
+                pregen: None,
                 shutdown: false,
             }),
             wake: Condvar::new(),
         });
         let mut handles = Vec::with_capacity(threads);
         for i in 0..threads.max(1) {
-            let (shared, generator, palette, done) = (shared.clone(), generator.clone(), palette.clone(), done.clone());
+            let (shared, source, done) = (shared.clone(), source.clone(), done.clone());
             let handle = thread::Builder::new()
                 .name(format!("chunk-worker-{i}"))
-                .spawn(move || work(&shared, &generator, &palette, compression, &done))?;
+                .spawn(move || work(&shared, &source, compression, &done))?;
             handles.push(handle);
         }
         Ok(Workers { shared, _threads: handles })
@@ -123,6 +128,17 @@ impl Workers {
         q.generation
     }
 
+    /// Works on `job` whenever no player chunk waits (`None`: no task).
+    pub fn set_pregen(&self, job: Option<Arc<Job>>) {
+        self.shared.lock().pregen = job;
+        self.shared.wake.notify_all();
+    }
+
+    /// A handle that wakes idle workers from any thread.
+    pub fn waker(&self) -> Waker {
+        Waker(self.shared.clone())
+    }
+
     /// The current rules generation.
     pub fn generation(&self) -> u64 {
         self.shared.lock().generation
@@ -144,15 +160,29 @@ impl Drop for Workers {
     }
 }
 
-fn work(
-    shared: &Shared,
-    generator: &Generator,
-    palette: &BiomePalette,
-    compression: CompressionThreshold,
-    done: &Sender<Finished>,
-) {
+/// Wakes idle workers (used by a pre-generation task when it resumes).
+#[derive(Clone)]
+pub struct Waker(Arc<Shared>);
+
+impl Waker {
+    /// Wakes every idle worker. Taking the lock first means a worker between "nothing to do"
+    /// and waiting cannot miss it.
+    pub fn wake(&self) {
+        drop(self.0.lock());
+        self.0.wake.notify_all();
+    }
+}
+
+/// What a worker does next.
+enum Task {
+    Player(ChunkPos, Arc<BiomeRules>, u64),
+    Pregen(Arc<Job>, u64, (i32, i32), Arc<BiomeRules>),
+}
+
+fn work(shared: &Shared, source: &ChunkSource, compression: CompressionThreshold, done: &Sender<Finished>) {
+    let mut scratch = source.scratch();
     loop {
-        let (pos, rules, generation) = {
+        let task = {
             let mut q = shared.lock();
             loop {
                 if q.shutdown {
@@ -160,14 +190,26 @@ fn work(
                 }
                 if let Some(pos) = q.pending.pop() {
                     q.in_flight.insert(pos);
-                    break (pos, q.rules.clone(), q.generation);
+                    break Task::Player(pos, q.rules.clone(), q.generation);
+                }
+                if let Some(job) = q.pregen.clone() {
+                    if let Some((n, pos)) = job.take() {
+                        break Task::Pregen(job, n, pos, q.rules.clone());
+                    }
                 }
                 q = shared.wake.wait(q).unwrap_or_else(PoisonError::into_inner);
             }
         };
+        let (pos, rules, generation) = match task {
+            Task::Player(pos, rules, generation) => (pos, rules, generation),
+            Task::Pregen(job, n, pos, rules) => {
+                pregen::generate(&job, source, &mut scratch, &rules, n, pos);
+                continue;
+            }
+        };
         let start = Instant::now();
         // A panic in one chunk must not take the worker (and all later chunks) with it.
-        let built = catch_unwind(AssertUnwindSafe(|| build(generator, &rules, palette, compression, pos)))
+        let built = catch_unwind(AssertUnwindSafe(|| build(source, &mut scratch, &rules, compression, pos)))
             .unwrap_or_else(|_| Err(anyhow::anyhow!("building it panicked (see above)")));
         let built = built.map_err(|e| tracing::error!("chunk {} {}: {e:#}", pos.x, pos.z)).ok();
         let finished = Finished { pos, built, generation, elapsed: start.elapsed() };
@@ -177,18 +219,22 @@ fn work(
     }
 }
 
-/// Builds one chunk and encodes its light packet the way valence encodes everything else.
+/// Loads or builds one chunk and encodes its light packet the way valence encodes everything
+/// else. An unreadable saved chunk is reported on the console and regenerated.
 fn build(
-    generator: &Generator,
+    source: &ChunkSource,
+    scratch: &mut Scratch,
     rules: &BiomeRules,
-    palette: &BiomePalette,
     compression: CompressionThreshold,
     pos: ChunkPos,
 ) -> anyhow::Result<Built> {
-    let chunk = generator.chunk(rules, palette, pos.x, pos.z);
+    let (chunk, light, origin) = source.get(scratch, rules, pos.x, pos.z);
+    if let Origin::Regenerated(reason) = origin {
+        say!("corrupt chunk {}, {}: {reason}; regenerated it", pos.x, pos.z);
+    }
     let mut encoder = PacketEncoder::new();
     encoder.set_compression(compression);
-    encoder.append_packet(&SkyLight::of(&chunk).packet(pos))?;
+    encoder.append_packet(&light.packet(pos))?;
     Ok(Built { chunk, light: Arc::from(&encoder.take()[..]) })
 }
 

@@ -1,0 +1,178 @@
+//! Pre-generation and joining, the whole way: terrain, climate, biomes, blocks, light, NBT,
+//! compression and region files, with the same code the server and `infiniterra pregen` run.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use valence::prelude::{ChunkPos, ChunkView};
+
+use super::Measurement;
+use crate::biome::BiomeRules;
+use crate::config::Config;
+use crate::fill::{BiomePalette, Generator, SkyLight};
+use crate::pregen::{generate, Job, Plan, Shape, Shard, Task};
+use crate::terrain::Pipeline;
+use crate::world::codec::Encoder;
+use crate::world::{region, ChunkSource, Store};
+
+/// Blocks per region edge.
+const REGION_BLOCKS: i64 = 512;
+
+/// Everything a run needs, built fresh (so "cold" is cold).
+struct Rig {
+    source: Arc<ChunkSource>,
+    store: Arc<Store>,
+    rules: Arc<BiomeRules>,
+    _dir: tempfile::TempDir,
+}
+
+impl Rig {
+    fn new(config: &Config, rules: &Arc<BiomeRules>) -> anyhow::Result<Rig> {
+        let dir = tempfile::tempdir()?;
+        let pipeline = Arc::new(Pipeline::new(config.world.seed, &config.terrain()));
+        let generator = Arc::new(Generator::new(pipeline, config));
+        let store = Arc::new(Store::open(dir.path())?);
+        let source = Arc::new(ChunkSource::new(generator, Arc::new(BiomePalette::vanilla()), Some(store.clone())));
+        Ok(Rig { source, store, rules: rules.clone(), _dir: dir })
+    }
+
+    /// Runs `task` on `threads` threads to the end; returns the seconds it took.
+    fn pregen(&self, config: &Config, task: Task, threads: usize) -> anyhow::Result<(f64, u64)> {
+        let plan = Plan::new(task, Shard::ALL);
+        let total = plan.total();
+        let progress = self._dir.path().join("pregen.json");
+        let start = Instant::now();
+        let job = Job::start(
+            plan,
+            config.world.seed,
+            self.store.clone(),
+            progress,
+            0,
+            Duration::MAX,
+            Box::new(|_| {}),
+            Box::new(|| {}),
+        )?;
+        std::thread::scope(|scope| {
+            for _ in 0..threads {
+                let (job, source, rules) = (&job, &self.source, &self.rules);
+                scope.spawn(move || {
+                    let mut scratch = source.scratch();
+                    while let Some((n, pos)) = job.take() {
+                        generate(job, source, &mut scratch, rules, n, pos);
+                    }
+                });
+            }
+        });
+        let status = job.wait();
+        job.join();
+        if let Some(e) = status.error {
+            anyhow::bail!("pre-generation failed: {e}");
+        }
+        self.store.flush()?;
+        Ok((start.elapsed().as_secs_f64(), total))
+    }
+}
+
+/// The pre-generation suite. `chunks`: size of the throughput run (0 skips it).
+pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<Measurement>> {
+    let rules = Arc::new(BiomeRules::load_dir(std::path::Path::new("biomes"))?);
+    let threads = config.server.chunk_threads as usize;
+    let mut out = Vec::new();
+
+    // Time to the first region file, from nothing: pipeline start-up (layout calibration)
+    // included. Each run at a fresh far place.
+    let mut first = Vec::new();
+    for run in 0..runs as i64 {
+        let start = Instant::now();
+        let rig = Rig::new(config, &rules)?;
+        let rx = 1_000 + run * 97;
+        let centre = rx * REGION_BLOCKS + REGION_BLOCKS / 2;
+        rig.pregen(config, Task { center_x: centre, center_z: -centre, radius: 256, shape: Shape::Square }, threads)?;
+        first.push(start.elapsed().as_secs_f64());
+    }
+    out.push(Measurement::new("pregen: first region file (1,024 chunks), cold start", "s", first));
+
+    // A player joining a place nobody has been, in a warm server: every chunk of view
+    // distance 10, nearest first, on the worker threads (network not included).
+    let rig = Rig::new(config, &rules)?;
+    let mut join = Vec::new();
+    for run in 0..runs as i32 {
+        let centre = ChunkPos::new(-40_000 - run * 1_000, 25_000 + run * 1_000);
+        let mut wanted: Vec<ChunkPos> = ChunkView::new(centre, 10).iter().collect();
+        wanted.sort_by_key(|p| std::cmp::Reverse(centre.distance_squared(*p)));
+        let queue = std::sync::Mutex::new(wanted);
+        let start = Instant::now();
+        std::thread::scope(|scope| {
+            for _ in 0..threads {
+                let (queue, rig) = (&queue, &rig);
+                scope.spawn(move || {
+                    let mut scratch = rig.source.scratch();
+                    while let Some(pos) = queue.lock().ok().and_then(|mut q| q.pop()) {
+                        rig.source.get(&mut scratch, &rig.rules, pos.x, pos.z);
+                    }
+                });
+            }
+        });
+        join.push(start.elapsed().as_secs_f64());
+    }
+    out.push(Measurement::new("join: all 441 chunks of view 10 at a new place, warm server", "s", join));
+
+    // Where a chunk's time goes, one thread, chunks in pre-generation order.
+    let rig = Rig::new(config, &rules)?;
+    let generator = rig.source.generator();
+    let palette = BiomePalette::vanilla();
+    let mut encoder = Encoder::new(generator.vertical().min_y, palette.names().to_vec());
+    let plan = Plan::new(Task { center_x: 7_000_000, center_z: 0, radius: 160, shape: Shape::Square }, Shard::ALL);
+    let (mut fill, mut light, mut encode, mut compress) = (0.0, 0.0, 0.0, 0.0);
+    for n in 0..plan.total() {
+        let (x, z) = plan.chunk(n);
+        let t = Instant::now();
+        let chunk = generator.chunk(&rules, &palette, x, z);
+        fill += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let sky = SkyLight::of(&chunk);
+        light += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let nbt = encoder.encode(x, z, &chunk, &sky);
+        encode += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        std::hint::black_box(region::compress(&nbt));
+        compress += t.elapsed().as_secs_f64();
+    }
+    let per = |s: f64| vec![1e3 * s / plan.total() as f64];
+    out.push(Measurement::new("per chunk, 1 thread: terrain + blocks + biomes (fill)", "ms", per(fill)));
+    out.push(Measurement::new("per chunk, 1 thread: sky light", "ms", per(light)));
+    out.push(Measurement::new("per chunk, 1 thread: NBT encoding", "ms", per(encode)));
+    out.push(Measurement::new("per chunk, 1 thread: zlib compression", "ms", per(compress)));
+
+    if chunks > 0 {
+        // Throughput and memory of a long run: a square of about `chunks` chunks.
+        reset_peak_rss();
+        let side = (chunks as f64).sqrt().ceil() as i64;
+        let rig = Rig::new(config, &rules)?;
+        let task = Task { center_x: -3_000_000, center_z: 3_000_000, radius: side * 8, shape: Shape::Square };
+        let (seconds, total) = rig.pregen(config, task, threads)?;
+        out.push(Measurement::new(
+            &format!("pregen: {} chunks, full pipeline + region files, {threads} threads", total),
+            "chunks/s",
+            vec![total as f64 / seconds],
+        ));
+        let peak = peak_rss_mib().unwrap_or(f64::NAN);
+        out.push(Measurement::new("pregen: peak resident memory during that run", "MiB", vec![peak]));
+    }
+    Ok(out)
+}
+
+/// Resets the kernel's peak-RSS counter (Linux: `echo 5 > /proc/self/clear_refs`), so the
+/// peak reported is that of the run that follows.
+fn reset_peak_rss() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// Peak resident memory of this process since start (or the last reset), MiB.
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}

@@ -1,0 +1,36 @@
+//! Pre-generation: a task (centre, radius, shape) worked through in a cache-friendly order,
+//! saved as it goes, resumable after any crash — from the server console (between players'
+//! chunks) or as a batch command split into shards by region file.
+//!
+//! Owns: the order, the progress file and the running job. Must not: decide how a chunk is
+//! made or stored (the world's [`ChunkSource`](crate::world::ChunkSource)).
+
+pub mod batch;
+mod job;
+pub mod plan;
+pub mod progress;
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use crate::biome::BiomeRules;
+use crate::world::{ChunkSource, Scratch};
+
+pub use job::{duration, thousands, Job, Status, REPORT_EVERY};
+pub use plan::{Plan, Shape, Shard, Task};
+pub use progress::{Progress, State};
+
+/// Generates and saves chunk number `n` at `pos` of `job` (skipped when already saved), then
+/// marks it done; a failure (a full disk, a bug) pauses the job with the reason.
+pub fn generate(job: &Job, source: &ChunkSource, scratch: &mut Scratch, rules: &BiomeRules, n: u64, pos: (i32, i32)) {
+    let (x, z) = pos;
+    match catch_unwind(AssertUnwindSafe(|| source.ensure_saved(scratch, rules, x, z))) {
+        Ok(Ok(_)) => job.complete(n),
+        Ok(Err(e)) => job.fail(e.to_string()),
+        Err(_) => job.fail(format!("generating chunk {x}, {z} panicked (see above)")),
+    }
+    // Writes fail asynchronously on the writer thread: stop promptly rather than at the next
+    // checkpoint.
+    if let Some(failure) = source.store().and_then(|s| s.failure()) {
+        job.fail(failure);
+    }
+}

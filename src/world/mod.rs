@@ -1,0 +1,42 @@
+//! The saved world: Anvil region files, the chunk ⇄ NBT codec, `level.dat`, the store that
+//! loads chunks from disk and writes new ones off the main thread, and the chunk source that
+//! puts the store in front of the generator.
+//!
+//! Owns: everything on disk under the world directory. Must not: decide which chunks are
+//! wanted (the server's and the pre-generator's) or how terrain looks (the generator's).
+
+mod chunks;
+pub mod codec;
+pub mod level;
+pub mod region;
+mod store;
+
+use std::path::Path;
+
+pub use chunks::{ChunkSource, Origin, Scratch};
+pub use store::{Store, StoreError};
+
+/// Makes `dir` ready for chunks of the world with `seed`: a world made with another seed is
+/// refused (its chunks would not match new ones), a missing `level.dat` is written with
+/// `spawn` so Minecraft and other tools open the world.
+pub fn prepare(dir: &Path, seed: u64, spawn: [i32; 3], game_type: i32) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| anyhow::anyhow!("cannot create the world folder {}: {e}", dir.display()))?;
+    let level = dir.join("level.dat");
+    if level.exists() {
+        let info = level::read_level_dat(dir).map_err(|e| anyhow::anyhow!("{}: {e}", level.display()))?;
+        if info.seed != seed {
+            anyhow::bail!(
+                "{} belongs to a world with seed {}, not {seed}: its chunks would not match; use that seed \
+                 (--seed {}) or another world.directory",
+                level.display(),
+                info.seed,
+                info.seed
+            );
+        }
+        return Ok(());
+    }
+    let name = dir.file_name().map_or_else(|| "world".to_string(), |n| n.to_string_lossy().into_owned());
+    level::write_level_dat(dir, &name, seed, spawn, game_type)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", level.display()))
+}
