@@ -273,3 +273,60 @@ fn amulet_reads_the_blocks_and_biomes_we_generate() {
     let biomes: std::collections::HashSet<_> = expected.iter().map(|e| &e.4).collect();
     assert!(biomes.len() >= 2, "only {biomes:?}");
 }
+
+#[test]
+fn a_full_disk_pauses_the_task_with_the_reason_and_a_rerun_finishes_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let config = config(dir.path(), 7);
+    let world = dir.path().join("world");
+    // One region file lives on a "disk" that is always full: Linux's /dev/full answers
+    // every write with ENOSPC.
+    std::fs::create_dir_all(world.join("region")).expect("mkdir");
+    let full = world.join("region").join("r.0.0.mca");
+    std::os::unix::fs::symlink("/dev/full", &full).expect("symlink");
+    let out = pregen(&config, &world, 48).output().expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("paused") && stderr.contains("r.0.0.mca"), "{stderr}");
+    assert!(stderr.contains("No space left on device"), "{stderr}");
+    let saved = Progress::load(&world.join("pregen.json")).expect("progress").expect("saved");
+    assert_eq!(saved.state, State::Paused);
+    assert!(saved.error.as_deref().is_some_and(|e| e.contains("No space left")), "{saved:?}");
+
+    // Space is back: the same command finishes the task, every chunk readable.
+    std::fs::remove_file(&full).expect("remove");
+    let done = run_to_end(pregen(&config, &world, 48));
+    assert!(done.contains("finished"), "{done}");
+    let total = Plan::new(Task { center_x: 0, center_z: 0, radius: 48, shape: Shape::Square }, Shard::ALL).total();
+    assert_eq!(saved_chunks(&world).len() as u64, total);
+}
+
+#[test]
+fn shards_write_disjoint_region_files_that_together_equal_the_whole_task() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let config = config(dir.path(), 7);
+    let (sharded, whole) = (dir.path().join("sharded"), dir.path().join("whole"));
+    let mut files_of = Vec::new();
+    for shard in ["0/2", "1/2"] {
+        let before: Vec<_> = region_files(&sharded);
+        let mut command = pregen(&config, &sharded, 300);
+        command.args(["--shard", shard]);
+        run_to_end(command);
+        let after = region_files(&sharded);
+        let new: Vec<_> = after.iter().filter(|f| !before.contains(f)).cloned().collect();
+        assert!(!new.is_empty(), "shard {shard} wrote nothing");
+        files_of.push(new);
+    }
+    assert!(sharded.join("pregen-0-of-2.json").is_file() && sharded.join("pregen-1-of-2.json").is_file());
+    assert!(files_of[0].iter().all(|f| !files_of[1].contains(f)), "shards share a region file");
+    run_to_end(pregen(&config, &whole, 300));
+    assert!(saved_chunks(&sharded) == saved_chunks(&whole), "the shards' union differs from the whole task");
+}
+
+fn region_files(world: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(world.join("region")) else { return Vec::new() };
+    let mut names: Vec<String> =
+        entries.map(|e| e.expect("entry").file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}

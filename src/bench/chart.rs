@@ -136,25 +136,27 @@ fn fill(img: &mut RgbImage, x: u32, y: u32, w: u32, h: u32, colour: Rgb<u8>) {
     }
 }
 
-/// `value` with about four significant digits; "n/a" when it is not finite.
+/// `value` with about four significant digits, trailing zeros dropped; "n/a" when it is not
+/// finite.
 fn number(value: f64) -> String {
     let magnitude = value.abs();
+    let trim = |s: String| if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
     if !value.is_finite() {
         "n/a".to_string()
     } else if magnitude == 0.0 {
         "0".to_string()
-    } else if magnitude >= 1e7 || magnitude < 1e-3 {
+    } else if !(1e-3..1e7).contains(&magnitude) {
         format!("{value:.3e}")
     } else if magnitude >= 1000.0 {
         format!("{value:.0}")
     } else if magnitude >= 100.0 {
-        format!("{value:.1}")
+        trim(format!("{value:.1}"))
     } else if magnitude >= 10.0 {
-        format!("{value:.2}")
+        trim(format!("{value:.2}"))
     } else if magnitude >= 1.0 {
-        format!("{value:.3}")
+        trim(format!("{value:.3}"))
     } else {
-        format!("{value:.4}")
+        trim(format!("{value:.4}"))
     }
 }
 
@@ -270,8 +272,11 @@ mod tests {
     #[test]
     fn numbers_are_short() {
         assert_eq!(number(12345.678), "12346");
-        assert_eq!(number(3.14159), "3.142");
+        assert_eq!(number(4.56789), "4.568");
         assert_eq!(number(0.012345), "0.0123");
+        assert_eq!(number(2.0), "2");
+        assert_eq!(number(0.5), "0.5");
+        assert_eq!(number(1500.0), "1500");
         assert_eq!(number(f64::NAN), "n/a");
     }
 

@@ -6,6 +6,7 @@
 //! Every figure is the median of several runs at different places of the world (fresh
 //! pipelines, so "cold" really is cold). Speed targets live here, never in timed tests.
 
+mod chart;
 mod engine;
 mod pipeline;
 mod pregen;
@@ -73,5 +74,24 @@ pub fn run(config: &Config, args: &BenchArgs) -> anyhow::Result<()> {
             println!("{:<58} {:>14.3}  {}", m.name, m.value, m.unit);
         }
     }
+    let bars: Vec<chart::Bar> = all.iter().map(|m| chart::Bar { measurement: m, goal: goal(config, m) }).collect();
+    let title = format!("infiniterra bench: {threads} hardware threads, seed {}, median of {runs}", config.world.seed);
+    chart::save(&args.out, &title, &bars)?;
+    if !args.json {
+        println!("wrote {}", args.out.display());
+    }
     Ok(())
+}
+
+/// The goal a measurement is judged against, where the project has one (issues #4 and #6).
+fn goal(config: &Config, m: &Measurement) -> Option<chart::Goal> {
+    let at_least = |value| Some(chart::Goal { value, higher_is_better: true });
+    let at_most = |value| Some(chart::Goal { value, higher_is_better: false });
+    match m.name.as_str() {
+        n if n.starts_with("pregen:") && m.unit == "chunks/s" => at_least(1_000.0),
+        n if n.starts_with("pregen: peak resident memory") => at_most(config.engine.cache_mib as f64 + 300.0),
+        "pipeline: first 512×512-block region, cold start" => at_most(1.5),
+        "pipeline: steady exploration, chunk-sized queries" => at_least(256_000.0),
+        _ => None,
+    }
 }

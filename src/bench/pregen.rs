@@ -10,7 +10,7 @@ use super::Measurement;
 use crate::biome::BiomeRules;
 use crate::config::Config;
 use crate::fill::{BiomePalette, Generator, SkyLight};
-use crate::pregen::{generate, Job, Plan, Shape, Shard, Task};
+use crate::pregen::{generate, Hooks, Job, Plan, Shape, Shard, Task};
 use crate::terrain::Pipeline;
 use crate::world::codec::Encoder;
 use crate::world::{region, ChunkSource, Store};
@@ -48,9 +48,7 @@ impl Rig {
             self.store.clone(),
             progress,
             0,
-            Duration::MAX,
-            Box::new(|_| {}),
-            Box::new(|| {}),
+            Hooks { report_every: Duration::MAX, report: Box::new(|_| {}), on_work: Box::new(|| {}) },
         )?;
         std::thread::scope(|scope| {
             for _ in 0..threads {
@@ -64,7 +62,7 @@ impl Rig {
             }
         });
         let status = job.wait();
-        job.join();
+        job.stop();
         if let Some(e) = status.error {
             anyhow::bail!("pre-generation failed: {e}");
         }

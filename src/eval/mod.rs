@@ -10,7 +10,7 @@
 pub mod data;
 mod input;
 mod measure;
-mod plot;
+pub(crate) mod plot;
 mod report;
 
 use std::path::{Path, PathBuf};

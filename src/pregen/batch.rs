@@ -11,7 +11,7 @@ use clap::Args;
 
 use super::plan::{Plan, Shape, Shard, Task};
 use super::progress::{self, Progress, State};
-use super::{generate, Job};
+use super::{generate, Hooks, Job};
 use crate::biome::BiomeRules;
 use crate::cli::Failure;
 use crate::config::Config;
@@ -116,9 +116,11 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
         store.clone(),
         progress_path.clone(),
         done,
-        Duration::from_secs_f64(args.report_every.max(0.0)),
-        Box::new(|line| println!("{line}")),
-        Box::new(|| {}),
+        Hooks {
+            report_every: Duration::from_secs_f64(args.report_every.max(0.0)),
+            report: Box::new(|line| println!("{line}")),
+            on_work: Box::new(|| {}),
+        },
     )
     .map_err(|e| Failure::runtime(anyhow::anyhow!("cannot write {}: {e}", progress_path.display())))?;
 
@@ -147,7 +149,8 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
         }
     });
     let status = job.wait();
-    job.join();
+    // Ends the checkpointer whether the task finished or paused (state saved as it is).
+    job.stop();
     store.close().map_err(Failure::runtime)?;
     let elapsed = started.elapsed().as_secs_f64();
     match status.state {

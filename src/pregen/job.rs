@@ -94,6 +94,16 @@ struct Inner {
     closed: bool,
 }
 
+/// How a job talks to whoever runs it.
+pub struct Hooks {
+    /// Time between progress lines.
+    pub report_every: Duration,
+    /// Receives the progress lines.
+    pub report: Box<dyn Fn(&str) + Send + Sync>,
+    /// Called when work becomes available (a start or a resume), to wake idle workers.
+    pub on_work: Box<dyn Fn() + Send + Sync>,
+}
+
 /// A task being worked on.
 pub struct Job {
     plan: Plan,
@@ -112,17 +122,16 @@ pub struct Job {
 
 impl Job {
     /// Starts (or resumes, from `done` chunks) `plan`, saving progress to `progress_path`
-    /// and printing through `report` every `report_every`. `on_work` is called when work becomes available.
+    /// and telling `hooks` how it goes.
     pub fn start(
         plan: Plan,
         seed: u64,
         store: Arc<Store>,
         progress_path: PathBuf,
         done: u64,
-        report_every: Duration,
-        report: Box<dyn Fn(&str) + Send + Sync>,
-        on_work: Box<dyn Fn() + Send + Sync>,
+        hooks: Hooks,
     ) -> std::io::Result<Arc<Job>> {
+        let Hooks { report_every, report, on_work } = hooks;
         let total = plan.total();
         let done = done.min(total);
         let job = Arc::new(Job {
@@ -284,7 +293,7 @@ impl Job {
     pub fn wait(&self) -> Status {
         {
             let mut inner = self.lock();
-            while !inner.closed && !(inner.state == State::Paused && inner.saved == State::Paused) {
+            while !(inner.closed || inner.state == State::Paused && inner.saved == State::Paused) {
                 inner = self.changed.wait(inner).unwrap_or_else(PoisonError::into_inner);
             }
         }

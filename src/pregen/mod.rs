@@ -15,7 +15,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use crate::biome::BiomeRules;
 use crate::world::{ChunkSource, Scratch};
 
-pub use job::{duration, thousands, Job, Status, REPORT_EVERY};
+pub use job::{duration, thousands, Hooks, Job, Status, REPORT_EVERY};
 pub use plan::{Plan, Shape, Shard, Task};
 pub use progress::{Progress, State};
 

@@ -11,7 +11,7 @@ use valence::prelude::*;
 
 use super::stream::Streamer;
 use super::world::WorldSetup;
-use crate::pregen::{progress, thousands, Job, Plan, Progress, Shape, Shard, State, Task};
+use crate::pregen::{progress, thousands, Hooks, Job, Plan, Progress, Shape, Shard, State, Task};
 
 /// Console help for the pregen commands.
 pub const HELP: &str = "  pregen start <x> <z> <radius> [square|circle]   pre-generate around block x, z
@@ -175,9 +175,11 @@ fn start(setup: &WorldSetup, control: &PregenControl, streamer: &Streamer, task:
         store,
         progress::path(dir, Shard::ALL),
         done,
-        crate::pregen::REPORT_EVERY,
-        Box::new(|line| say!("{line}")),
-        Box::new(move || waker.wake()),
+        Hooks {
+            report_every: crate::pregen::REPORT_EVERY,
+            report: Box::new(|line| say!("{line}")),
+            on_work: Box::new(move || waker.wake()),
+        },
     );
     match job {
         Ok(job) => {
