@@ -17,7 +17,7 @@ use infiniterra::fill::Generator;
 use infiniterra::server::find_spawn;
 use infiniterra::terrain::Pipeline;
 use serde_json::Value;
-use valence::prelude::{ChunkPos, ChunkView};
+use valence::prelude::{BlockState, ChunkPos, ChunkView};
 
 /// Start-up includes building the pipeline and searching a spawn point in a debug build.
 const START_TIMEOUT: Duration = Duration::from_secs(180);
@@ -523,8 +523,29 @@ fn batch_pregen(config: &Config, world: &Path, center: (i64, i64), radius: i64) 
     assert!(out.status.success(), "pregen: {}", String::from_utf8_lossy(&out.stderr));
 }
 
+/// Sets block (`at`, `y`) of saved chunk `chunk` to `block`, as an editor such as Amulet would.
+fn edit_block(world: &Path, generator: &Generator, chunk: (i32, i32), at: (i64, i64), y: i32, block: BlockState) {
+    use infiniterra::fill::{BiomePalette, SkyLight};
+    use infiniterra::world::codec::{Decoder, Encoder};
+    use infiniterra::world::region::{compress, local, RegionFile, RegionPos};
+    use valence::prelude::Chunk;
+    let v = generator.vertical();
+    let palette = Arc::new(BiomePalette::vanilla());
+    let path = world.join("region").join(RegionPos::of_chunk(chunk.0, chunk.1).file_name());
+    let mut file = RegionFile::open(&path, false).expect("open region");
+    let (lx, lz) = local(chunk.0, chunk.1);
+    let nbt = file.read(lx, lz).expect("readable").expect("saved");
+    let mut blocks =
+        Decoder::new(v.min_y, v.height as u32, palette.clone()).decode(chunk.0, chunk.1, &nbt).expect("decode");
+    let (bx, bz) = (at.0.rem_euclid(16) as u32, at.1.rem_euclid(16) as u32);
+    blocks.set_block_state(bx, (y - v.min_y) as u32, bz, block);
+    let nbt = Encoder::new(v.min_y, palette.names().to_vec()).encode(chunk.0, chunk.1, &blocks, &SkyLight::of(&blocks));
+    file.write(lx, lz, &compress(&nbt), 0).expect("write");
+    file.sync().expect("sync");
+}
+
 #[test]
-fn a_corrupt_saved_chunk_is_reported_and_served_regenerated() {
+fn saved_chunks_are_loaded_and_a_corrupt_one_is_reported_and_served_regenerated() {
     use infiniterra::world::region::{local, RegionFile, RegionPos};
     let seed = 6;
     let keep = tempfile::tempdir().expect("temp dir");
@@ -550,16 +571,28 @@ fn a_corrupt_saved_chunk_is_reported_and_served_regenerated() {
     std::fs::write(&path, &bytes).expect("write region");
     assert!(RegionFile::open(&path, false).expect("open").read(lx, lz).is_err(), "the chunk still reads");
 
+    // And an edit by another tool in the chunk east of it: a gold block on top of one column.
+    // Seeing it proves saved chunks are loaded, not generated again.
+    let (ex, ez) = (cx + 1, cz);
+    let edited = (i64::from(ex) * 16 + 5, i64::from(ez) * 16 + 9);
+    let gold_y = generator.surface(&rules, edited.0, edited.1).y.max(generator.vertical().water_top_y()) + 1;
+    edit_block(&world, &generator, (ex, ez), edited, gold_y, BlockState::GOLD_BLOCK);
+
     let dir = tempfile::tempdir().expect("temp dir");
     let mut server = Server::start_with(&repo().join("biomes"), seed, dir, &world_config(&world));
-    let columns: Vec<(i64, i64)> = (0..16).map(|i| (cx as i64 * 16 + i, cz as i64 * 16 + 15 - i)).collect();
+    let mut columns: Vec<(i64, i64)> = (0..16).map(|i| (cx as i64 * 16 + i, cz as i64 * 16 + 15 - i)).collect();
+    columns.push(edited);
     let list = columns.iter().map(|(x, z)| format!("{x},{z}")).collect::<Vec<_>>().join(";");
     let report = server.probe("inspector", &["--columns".into(), list]);
+    let seen = report["columns"].as_array().expect("columns");
+    let gold = seen.last().expect("the edited column");
+    assert_eq!((gold["block"].as_str(), gold["y"].as_i64()), (Some("gold_block"), Some(i64::from(gold_y))), "{gold}");
+    columns.pop();
     let line = server.expect_line(|l| l.starts_with("corrupt chunk"), LINE_TIMEOUT);
     assert!(line.starts_with(&format!("corrupt chunk {cx}, {cz}:")) && line.contains("regenerated"), "{line}");
     assert!(line.contains(&RegionPos::of_chunk(cx, cz).file_name()), "{line}");
     let v = *generator.vertical();
-    for (c, &(x, z)) in report["columns"].as_array().expect("columns").iter().zip(&columns) {
+    for (c, &(x, z)) in seen.iter().zip(&columns) {
         let s = generator.surface(&rules, x, z);
         let expected_y = if s.y >= v.water_top_y() { s.y } else { v.water_top_y() };
         assert_eq!(c["y"].as_i64(), Some(i64::from(expected_y)), "column ({x}, {z}): {c}");
