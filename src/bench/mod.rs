@@ -62,7 +62,7 @@ pub fn run(config: &Config, args: &BenchArgs) -> anyhow::Result<()> {
     let runs = args.runs.max(1);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut all = engine::measure(runs);
-    all.extend(pipeline::measure(config, runs));
+    all.extend(pipeline::measure(config, runs)?);
     all.extend(pregen::measure(config, runs, args.pregen_chunks)?);
     if args.json {
         let doc = serde_json::json!({ "machine_threads": threads, "seed": config.world.seed, "measurements": all });

@@ -7,19 +7,19 @@ use crate::config::Config;
 use crate::terrain::{Pipeline, Rect};
 
 /// Cold 512×512-block region, and chunk-by-chunk steady exploration.
-pub fn measure(config: &Config, runs: usize) -> Vec<Measurement> {
+pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>> {
     let (mut first_region, mut steady, mut warm) = (Vec::new(), Vec::new(), Vec::new());
     for run in 0..runs as i64 {
         // A different far place per run, so each starts cold.
         let origin = (run * 1_000_003 - 3_000_000, -run * 700_001 + 2_000_000);
-        let pipeline = Pipeline::new(config.world.seed, &config.terrain());
+        let pipeline = Pipeline::build(config.world.seed, &config.terrain())?;
         let start = Instant::now();
         pipeline.columns(Rect::new(origin.1, origin.0, 512, 512));
         first_region.push(start.elapsed().as_secs_f64());
 
         // Steady exploration: a player's new chunks, one 16×16 query each, walking east
         // across fresh ground in a band 32 chunks wide.
-        let pipeline = Pipeline::new(config.world.seed, &config.terrain());
+        let pipeline = Pipeline::build(config.world.seed, &config.terrain())?;
         let (cx0, cz0) = (origin.0 / 16 + 50_000, origin.1 / 16);
         let start = Instant::now();
         let mut columns = 0u64;
@@ -40,9 +40,9 @@ pub fn measure(config: &Config, runs: usize) -> Vec<Measurement> {
         }
         warm.push(columns as f64 / start.elapsed().as_secs_f64());
     }
-    vec![
+    Ok(vec![
         Measurement::new("pipeline: first 512×512-block region, cold start", "s", first_region),
         Measurement::new("pipeline: steady exploration, chunk-sized queries", "columns/s", steady),
         Measurement::new("pipeline: revisiting generated chunks (cache warm)", "columns/s", warm),
-    ]
+    ])
 }

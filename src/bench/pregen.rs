@@ -29,7 +29,7 @@ struct Rig {
 impl Rig {
     fn new(config: &Config, rules: &Arc<BiomeRules>) -> anyhow::Result<Rig> {
         let dir = tempfile::tempdir()?;
-        let pipeline = Arc::new(Pipeline::new(config.world.seed, &config.terrain()));
+        let pipeline = Arc::new(Pipeline::build(config.world.seed, &config.terrain())?);
         let generator = Arc::new(Generator::new(pipeline, config));
         let store = Arc::new(Store::open(dir.path())?);
         let source = Arc::new(ChunkSource::new(generator, Arc::new(BiomePalette::vanilla()), Some(store.clone())));

@@ -70,8 +70,8 @@ fn classify<E: std::error::Error + Send + Sync + 'static>(bad_input: bool, e: E)
     }
 }
 
-fn pipeline(config: &Config) -> Pipeline {
-    Pipeline::new(config.world.seed, &config.terrain())
+fn pipeline(config: &Config) -> Result<Pipeline, Failure> {
+    Pipeline::build(config.world.seed, &config.terrain()).map_err(Failure::input)
 }
 
 /// Runs `render`.
@@ -90,10 +90,10 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
     let mut progress = Progress::new("render", "rows");
     let image = if a.layer == Layer::Biome {
         let rules = BiomeRules::load_dir(&a.biomes).map_err(Failure::input)?;
-        let generator = Generator::new(std::sync::Arc::new(pipeline(config)), config);
+        let generator = Generator::new(std::sync::Arc::new(pipeline(config)?), config);
         render::render_biomes(&generator, &rules, &req, &mut |d, t| progress.update(d, t))
     } else {
-        render::render(&pipeline(config), &req, &mut |d, t| progress.update(d, t))
+        render::render(&pipeline(config)?, &req, &mut |d, t| progress.update(d, t))
     }
     .map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
@@ -113,7 +113,7 @@ pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
     };
     let vertical =
         Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
-    let pipeline = pipeline(config);
+    let pipeline = pipeline(config)?;
     let mut progress = Progress::new("export", "rows");
     let summary = export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t))
         .map_err(|e| classify(e.is_bad_input(), e))?;

@@ -47,3 +47,12 @@ fn structural_world_values_are_checked() {
 fn an_empty_file_means_every_default() {
     assert_eq!(parse("").unwrap(), Config::default());
 }
+
+#[test]
+fn learned_stage_names_and_backends_are_checked() {
+    let err = parse("[engine]\nlearned = [\"core\", \"detail\"]\n").unwrap_err().to_string();
+    assert!(err.starts_with("config/test.toml:2: engine.learned = \"detail\"") && err.contains("core"), "{err}");
+    let err = parse("[engine]\nbackend = \"cuda\"\n").unwrap_err().to_string();
+    assert!(err.contains("engine.backend = \"cuda\"") && err.contains("\"wgpu\""), "{err}");
+    assert_eq!(parse("[engine]\nlearned = [\"core\"]\n").unwrap().engine.learned, vec!["core".to_string()]);
+}

@@ -92,7 +92,7 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
         }
     };
 
-    let pipeline = Arc::new(Pipeline::new(seed, &config.terrain()));
+    let pipeline = Arc::new(Pipeline::build(seed, &config.terrain()).map_err(Failure::input)?);
     let generator = Arc::new(Generator::new(pipeline, config));
     let spawn = find_spawn(&generator, &rules);
     world::prepare(&world_dir, seed, [spawn.block.x, spawn.block.y, spawn.block.z], game_type(config))

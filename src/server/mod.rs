@@ -74,7 +74,9 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
         );
     }
 
-    let pipeline = Arc::new(Pipeline::new(config.world.seed, &config.terrain()));
+    let pipeline =
+        Pipeline::build(config.world.seed, &config.terrain()).map_err(|e| ServeError::Input(anyhow::anyhow!("{e}")))?;
+    let pipeline = Arc::new(pipeline);
     let generator = Arc::new(Generator::new(pipeline, config));
     say!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
     let spawn = find_spawn(&generator, &rules);

@@ -4,6 +4,8 @@
 //! `[engine]`); this module only knows names, defaults and ranges, so the error a server
 //! owner sees can name the key and what is allowed.
 
+use std::path::PathBuf;
+
 use serde::Deserialize;
 
 pub use crate::climate::ClimateSettings;
@@ -30,7 +32,7 @@ pub fn check_range<T: PartialOrd + std::fmt::Display>(key: &str, value: T, min: 
     }
 }
 
-/// The engine's cache and threads, as the owner sets them.
+/// The engine's cache and threads, and which learned stages run, as the owner sets them.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EngineSettings {
@@ -38,11 +40,26 @@ pub struct EngineSettings {
     pub cache_mib: u64,
     /// Threads evaluating missing windows of one query.
     pub threads: u64,
+    /// Learned stages to run, by name (`"core"`); empty: the procedural layout stands in.
+    pub learned: Vec<String>,
+    /// Folder of the weights (`<stage>.json` manifest + `<stage>.safetensors`).
+    pub models: PathBuf,
+    /// Backend of the learned stages: `"cpu"` (burn's pure-Rust backend) or `"wgpu"`.
+    pub backend: String,
 }
+
+/// Learned stages that exist (have code and can be trained).
+pub const LEARNED_STAGES: [&str; 1] = ["core"];
 
 impl Default for EngineSettings {
     fn default() -> Self {
-        EngineSettings { cache_mib: 256, threads: 2 }
+        EngineSettings {
+            cache_mib: 256,
+            threads: 2,
+            learned: Vec::new(),
+            models: PathBuf::from("models"),
+            backend: "cpu".into(),
+        }
     }
 }
 
@@ -50,7 +67,24 @@ impl EngineSettings {
     /// Checks every value against its range.
     pub fn validate(&self) -> Result<(), RangeError> {
         check_range("engine.cache_mib", self.cache_mib, 1, 65_536)?;
-        check_range("engine.threads", self.threads, 1, 256)
+        check_range("engine.threads", self.threads, 1, 256)?;
+        if !["cpu", "wgpu"].contains(&self.backend.as_str()) {
+            return Err(RangeError {
+                key: "engine.backend".into(),
+                value: format!("{:?}", self.backend),
+                allowed: "\"cpu\" or \"wgpu\"".into(),
+            });
+        }
+        for stage in &self.learned {
+            if !LEARNED_STAGES.contains(&stage.as_str()) {
+                return Err(RangeError {
+                    key: "engine.learned".into(),
+                    value: format!("{stage:?}"),
+                    allowed: format!("stages with a model: {:?}", LEARNED_STAGES),
+                });
+            }
+        }
+        Ok(())
     }
 }
 

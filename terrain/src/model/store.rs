@@ -282,6 +282,20 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
     }
     manifest.architecture.validate().map_err(|e| manifest_corrupt(format!("architecture: {e}")))?;
     manifest.sampler.validate().map_err(|e| manifest_corrupt(format!("sampler: {e}")))?;
+    // Scales divide values on the way in: zero or non-finite ones would turn the terrain into
+    // NaN rather than fail here.
+    let n = &manifest.normalisation;
+    for (name, v) in [("target_scale", n.target_scale), ("cond_scale", n.cond_scale), ("relief_std", n.relief_std)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(manifest_corrupt(format!("normalisation.{name} = {v} (must be a positive number)")));
+        }
+    }
+    if !(manifest.metres_per_pixel.is_finite() && manifest.metres_per_pixel > 0.0) {
+        return Err(manifest_corrupt(format!("metres_per_pixel = {} (must be positive)", manifest.metres_per_pixel)));
+    }
+    if manifest.window < 8 || manifest.window % 8 != 0 {
+        return Err(manifest_corrupt(format!("window = {} (must be a multiple of 8, at least 8)", manifest.window)));
+    }
 
     let dir = manifest_path.parent().unwrap_or(Path::new("."));
     let weights_path = dir.join(&manifest.weights);

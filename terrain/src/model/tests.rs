@@ -144,7 +144,12 @@ fn the_sampler_is_deterministic_for_fixed_noise() {
 }
 
 fn manifest_for(net: &UNet) -> ModelManifest {
-    ModelManifest::new("test", net.config.clone(), Sampler::karras(SamplerKind::Renoise, 2, 0.3, 40.0, 7.0))
+    let mut manifest =
+        ModelManifest::new("test", net.config.clone(), Sampler::karras(SamplerKind::Renoise, 2, 0.3, 40.0, 7.0));
+    manifest.metres_per_pixel = 1000.0;
+    manifest.normalisation =
+        Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+    manifest
 }
 
 #[test]

@@ -44,6 +44,41 @@ pub mod channel {
         ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct"];
 }
 
+/// Why a pipeline could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// Learned stages were asked for in a build without the learned-model code.
+    #[error(
+        "engine.learned = {0:?} needs the learned-model code: build with `cargo build --release --features learned`"
+    )]
+    NotBuilt(Vec<String>),
+    /// A model could not be loaded (the message names the file and the command that makes it).
+    #[cfg(feature = "learned")]
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
+    /// The backend is not known or not built in.
+    #[cfg(feature = "learned")]
+    #[error(transparent)]
+    Backend(#[from] crate::model::BackendError),
+}
+
+/// A grid `factor`× finer than its source's, by exact bilinear interpolation.
+#[cfg_attr(not(feature = "learned"), allow(dead_code))]
+struct Upsampled {
+    source: Arc<dyn Source>,
+    factor: i64,
+}
+
+impl Source for Upsampled {
+    fn channels(&self) -> usize {
+        self.source.channels()
+    }
+
+    fn query(&self, rect: Rect) -> Tile {
+        upsample::bilinear(&self.source.query(upsample::source_rect(&rect, self.factor)), self.factor, rect)
+    }
+}
+
 /// The terrain pipeline for one seed: thread-safe, shared by every chunk worker.
 pub struct Pipeline {
     seed: u64,
@@ -57,8 +92,15 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// Builds the pipeline of `seed` with validated `settings`.
+    /// Builds the pipeline of `seed` with validated `settings` that ask for no learned stage
+    /// (tests, tools); panics otherwise — use [`Pipeline::build`].
     pub fn new(seed: u64, settings: &TerrainSettings) -> Pipeline {
+        Pipeline::build(seed, settings).unwrap_or_else(|e| panic!("Pipeline::new: {e}"))
+    }
+
+    /// Builds the pipeline of `seed` with validated `settings`, loading the learned stages
+    /// they name (`engine.learned`) from `engine.models` on `engine.backend`.
+    pub fn build(seed: u64, settings: &TerrainSettings) -> Result<Pipeline, PipelineError> {
         let engine = Engine::new(EngineConfig {
             cache_bytes: (settings.engine.cache_mib as usize) << 20,
             threads: settings.engine.threads as usize,
@@ -79,17 +121,22 @@ impl Pipeline {
                 margin: 48,
             },
         );
-        let elevation: Arc<dyn Source> = Arc::new(layout.elevation(MODEL_PIXEL_METRES));
-        Pipeline {
+        let mut stages = stages::current();
+        let elevation: Arc<dyn Source> = if settings.engine.learned.is_empty() {
+            Arc::new(layout.elevation(MODEL_PIXEL_METRES))
+        } else {
+            learned_elevation(seed, settings, &engine, coarse_elevation.clone(), &mut stages)?
+        };
+        Ok(Pipeline {
             seed,
             settings: settings.clone(),
             engine,
-            stages: stages::current(),
+            stages,
             elevation,
             coarse_elevation,
             coarse_sketch,
             precipitation,
-        }
+        })
     }
 
     /// The world seed.
@@ -170,6 +217,40 @@ impl Pipeline {
         let (cy, cx) = (crate::tile::div_floor(z, f), crate::tile::div_floor(x, f));
         self.coarse_elevation.query(Rect::new(cy, cx, 1, 1)).data[0]
     }
+}
+
+/// The learned core stage on its 1 km grid, conditioned on the 8 km sketch, brought to the
+/// 500 m model grid (the detail stage that would add the finest relief is not trained yet).
+#[cfg(feature = "learned")]
+fn learned_elevation(
+    seed: u64,
+    settings: &TerrainSettings,
+    engine: &Arc<Engine>,
+    coarse: Arc<dyn Source>,
+    stages: &mut [StageStatus],
+) -> Result<Arc<dyn Source>, PipelineError> {
+    use crate::model::{load_model, stage::CoreStage, ComputeBackend};
+    let backend: ComputeBackend = settings.engine.backend.parse()?;
+    let device = backend.device()?;
+    let model = load_model(&settings.engine.models, "core", &device)?;
+    let core_metres = model.manifest.metres_per_pixel;
+    let factor = (core_metres / MODEL_PIXEL_METRES).round().max(1.0) as i64;
+    let core = Windowed::new(engine, CoreStage::new(model, device, coarse, seed, 8));
+    for s in stages.iter_mut().filter(|s| s.name == "core") {
+        s.state = StageState::Active;
+    }
+    Ok(Arc::new(Upsampled { source: core, factor }))
+}
+
+#[cfg(not(feature = "learned"))]
+fn learned_elevation(
+    _seed: u64,
+    settings: &TerrainSettings,
+    _engine: &Arc<Engine>,
+    _coarse: Arc<dyn Source>,
+    _stages: &mut [StageStatus],
+) -> Result<Arc<dyn Source>, PipelineError> {
+    Err(PipelineError::NotBuilt(settings.engine.learned.clone()))
 }
 
 #[cfg(test)]

@@ -5,7 +5,8 @@ use super::*;
 use crate::settings::{EngineSettings, TerrainSettings};
 
 fn pipeline(seed: u64, cache_mib: u64, threads: u64) -> Pipeline {
-    let settings = TerrainSettings { engine: EngineSettings { cache_mib, threads }, ..Default::default() };
+    let settings =
+        TerrainSettings { engine: EngineSettings { cache_mib, threads, ..Default::default() }, ..Default::default() };
     Pipeline::new(seed, &settings)
 }
 
@@ -121,4 +122,81 @@ fn temperature_is_the_sea_level_field_minus_the_lapse_rate() {
         }
     }
     assert!(checked > 20, "only {checked} pixel pairs on hills");
+}
+
+#[cfg(not(feature = "learned"))]
+#[test]
+fn learned_stages_in_a_build_without_them_say_how_to_build() {
+    let mut settings = TerrainSettings::default();
+    settings.engine.learned = vec!["core".into()];
+    let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
+    assert!(err.contains("core") && err.contains("--features learned"), "{err}");
+}
+
+/// The learned core stage inside the pipeline, with a small untrained network (what it
+/// computes does not matter here, only that the pipeline around it keeps its guarantees).
+#[cfg(feature = "learned")]
+mod learned {
+    use super::*;
+    use crate::model::{save_model, ModelManifest, Normalisation, Precision, Sampler, SamplerKind, UNet, UNetConfig};
+
+    fn models_dir(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("infiniterra-pipeline-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let net = UNet::new(&UNetConfig::tiny(), 3, &burn::tensor::Device::flex());
+        let mut manifest =
+            ModelManifest::new("core", net.config.clone(), Sampler::karras(SamplerKind::Euler, 2, 0.05, 40.0, 7.0));
+        manifest.window = 32;
+        manifest.metres_per_pixel = 1000.0;
+        manifest.normalisation =
+            Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+        save_model(&dir, &net, manifest, Precision::F32).expect("save");
+        dir
+    }
+
+    fn learned(seed: u64, models: &std::path::Path, cache_mib: u64, threads: u64) -> Pipeline {
+        let engine = EngineSettings {
+            cache_mib,
+            threads,
+            learned: vec!["core".into()],
+            models: models.to_path_buf(),
+            backend: "cpu".into(),
+        };
+        Pipeline::build(seed, &TerrainSettings { engine, ..Default::default() }).expect("learned pipeline")
+    }
+
+    #[test]
+    fn with_the_core_stage_a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
+        let models = models_dir("determinism");
+        let whole = Rect::new(40_000, -123_456, 64, 64);
+        let reference = learned(5, &models, 256, 1);
+        assert!(reference.active_stages().contains(&"core".to_string()), "{:?}", reference.active_stages());
+        let reference = reference.columns(whole);
+        assert!(reference.data.iter().all(|v| v.is_finite()), "the learned pipeline made non-finite values");
+        for (cache_mib, threads, order) in [(256, 2, 1), (1, 2, 2)] {
+            let p = learned(5, &models, cache_mib, threads);
+            let chunks: Vec<Rect> =
+                (0..16).map(|i| Rect::new(whole.y0 + (i / 4) * 16, whole.x0 + (i % 4) * 16, 16, 16)).collect();
+            for r in shuffled(chunks, order) {
+                assert!(
+                    p.columns(r) == reference.crop(r),
+                    "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)"
+                );
+            }
+        }
+        // The learned stage really shapes the terrain: not the layout's elevation.
+        let procedural = pipeline(5, 256, 1).columns(whole);
+        assert_ne!(procedural.channel(channel::ELEVATION), reference.channel(channel::ELEVATION));
+        let _ = std::fs::remove_dir_all(&models);
+    }
+
+    #[test]
+    fn missing_weights_name_the_file_and_the_command_that_makes_them() {
+        let empty = std::env::temp_dir().join(format!("infiniterra-no-models-{}", std::process::id()));
+        let mut settings = TerrainSettings::default();
+        settings.engine.learned = vec!["core".into()];
+        settings.engine.models = empty;
+        let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
+        assert!(err.contains("core.json") && err.contains("train core"), "{err}");
+    }
 }
