@@ -366,9 +366,9 @@ fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
 #[test]
 fn start_up_problems_exit_with_a_message_and_the_documented_code() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let run = |bind: &str, biomes: &Path| {
+    let run_with = |text: &str, biomes: &Path| {
         let config = dir.path().join("server.toml");
-        std::fs::write(&config, format!("[server]\nbind = \"{bind}\"\n")).expect("write config");
+        std::fs::write(&config, text).expect("write config");
         let out = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
             .arg("serve")
             .arg("--config")
@@ -380,6 +380,7 @@ fn start_up_problems_exit_with_a_message_and_the_documented_code() {
             .expect("run infiniterra serve");
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
     };
+    let run = |bind: &str, biomes: &Path| run_with(&format!("[server]\nbind = \"{bind}\"\n"), biomes);
     let biomes = repo().join("biomes");
 
     let (code, stderr) = run("127.0.0.1:25565", &dir.path().join("no-such-dir"));
@@ -395,6 +396,19 @@ fn start_up_problems_exit_with_a_message_and_the_documented_code() {
     let (code, stderr) = run(&address, &biomes);
     assert_eq!(code, Some(1), "{stderr}");
     assert!(stderr.contains("cannot listen on") && stderr.contains(&address), "{stderr}");
+    drop(taken);
+
+    // A learned stage without its weights (or without the learned-model code in this build):
+    // refused at start-up, naming what is missing.
+    let none = dir.path().join("none").display().to_string();
+    let text =
+        format!("[server]\nbind = \"127.0.0.1:{}\"\n[engine]\nlearned = [\"core\"]\nmodels = {none:?}\n", free_port());
+    let (code, stderr) = run_with(&text, &biomes);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("core") && (stderr.contains("--features learned") || stderr.contains("core.json")),
+        "{stderr}"
+    );
 }
 
 #[test]
