@@ -2,10 +2,11 @@
 //! writes queued to one writer thread so generation never waits on the disk (until the
 //! queue is full, which bounds the memory of chunks not yet written).
 
+use std::collections::HashMap;
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, SyncSender};
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError, Weak};
 use std::thread::JoinHandle;
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -74,6 +75,9 @@ enum Job {
 struct Files {
     dir: PathBuf,
     open: Mutex<LruCache<RegionPos, Arc<Mutex<RegionFile>>>>,
+    /// Every instance still in use, evicted from `open` or not: a file must never have two
+    /// instances at once, or their in-memory headers would disagree about free sectors.
+    live: Mutex<HashMap<RegionPos, Weak<Mutex<RegionFile>>>>,
 }
 
 impl Files {
@@ -97,14 +101,19 @@ impl Files {
         if create {
             std::fs::create_dir_all(&self.dir).map_err(|source| RegionError::Io { path: self.dir.clone(), source })?;
         }
-        let file = Arc::new(Mutex::new(RegionFile::open(&path, create)?));
-        // Two threads may race to open the same file: keep whichever got in first so every
-        // user shares one in-memory header.
-        let mut open = self.lock_open();
-        if let Some(existing) = open.get(&pos) {
-            return Ok(Some(existing.clone()));
-        }
-        open.put(pos, file.clone());
+        // Opening happens under the `live` lock, so two threads cannot open the same file twice,
+        // and an instance evicted from the LRU but still held elsewhere is reused.
+        let mut live = self.live.lock().unwrap_or_else(PoisonError::into_inner);
+        let file = match live.get(&pos).and_then(Weak::upgrade) {
+            Some(file) => file,
+            None => {
+                let file = Arc::new(Mutex::new(RegionFile::open(&path, create)?));
+                live.retain(|_, w| w.strong_count() > 0);
+                live.insert(pos, Arc::downgrade(&file));
+                file
+            }
+        };
+        self.lock_open().put(pos, file.clone());
         Ok(Some(file))
     }
 }
@@ -129,6 +138,7 @@ impl Store {
         let files = Arc::new(Files {
             dir: world_dir.join("region"),
             open: Mutex::new(LruCache::new(NonZeroUsize::new(OPEN_FILES).expect("non-zero"))),
+            live: Mutex::new(HashMap::new()),
         });
         let (jobs, queue) = mpsc::sync_channel(QUEUE);
         let failure = Arc::new(Mutex::new(None));
@@ -254,4 +264,52 @@ fn write_loop(files: &Files, queue: &Receiver<Job>, failure: &Mutex<Option<Strin
 /// chunk's data, so it does not affect determinism of what is saved.
 fn now_seconds() -> u32 {
     SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs() as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn nbt_of(x: i32, z: i32) -> Vec<u8> {
+        // Distinct, compressible bytes per chunk (the store does not parse them).
+        (0..3000u32).map(|i| (i as i32 ^ x.wrapping_mul(31) ^ z.wrapping_mul(17)) as u8 / 7).collect()
+    }
+
+    #[test]
+    fn chunks_round_trip_across_more_region_files_than_stay_open() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let store = Store::open(dir.path()).expect("store");
+        // 100 regions (more than OPEN_FILES), two chunks each, reads interleaved with writes.
+        let chunks: Vec<(i32, i32)> =
+            (0..100).flat_map(|r: i32| [(r * 32 - 1600, -(r % 7) * 32), (r * 32 - 1599, -(r % 7) * 32 + 5)]).collect();
+        for (i, &(x, z)) in chunks.iter().enumerate() {
+            store.save(x, z, &nbt_of(x, z)).expect("save");
+            if i % 3 == 0 {
+                store.flush().expect("flush");
+                let (px, pz) = chunks[i / 2];
+                assert_eq!(store.load(px, pz).expect("load"), Some(nbt_of(px, pz)), "chunk {px}, {pz}");
+            }
+        }
+        store.close().expect("close");
+        let again = Store::open(dir.path()).expect("reopen");
+        for &(x, z) in &chunks {
+            assert!(again.contains(x, z).expect("contains"));
+            assert_eq!(again.load(x, z).expect("load"), Some(nbt_of(x, z)), "chunk {x}, {z}");
+        }
+        assert_eq!(again.load(5000, 5000).expect("absent"), None);
+        assert!(!again.contains(5000, 5000).expect("absent"));
+    }
+
+    #[test]
+    fn a_failed_write_is_reported_by_flush_with_the_file_and_then_cleared() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        // The region folder is a file: nothing can be created in it.
+        std::fs::write(dir.path().join("region"), b"not a folder").expect("write");
+        let store = Store::open(dir.path()).expect("store");
+        store.save(0, 0, &nbt_of(0, 0)).expect("queued");
+        let err = store.flush().expect_err("the write failed").to_string();
+        assert!(err.contains("region"), "{err}");
+        assert_eq!(store.failure(), None, "flush clears the recorded failure");
+        assert!(store.flush().is_ok(), "nothing new failed");
+    }
 }
