@@ -319,3 +319,29 @@ fn bench_core_windows_per_second() {
         );
     }
 }
+
+/// One core window on wgpu (Mesa's software Vulkan in CI) and on the CPU backend: same
+/// weights, same noise, outputs within float tolerance.
+#[cfg(feature = "wgpu")]
+#[test]
+fn one_core_window_on_wgpu_matches_the_cpu_backend() {
+    let dir = tempdir("wgpu");
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    save_model(&dir, &net, manifest, Precision::F32).expect("save");
+    let run = |backend: ComputeBackend| {
+        let device = backend.device().expect("backend built in");
+        let model = load_model(&dir, "test", &device).expect("load");
+        let engine = Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 });
+        // One window: a 16×16 query inside the first window's unshared core.
+        Windowed::new(&engine, CoreStage::new(model, device, Arc::new(Hills), 42, 1)).query(Rect::new(8, 8, 16, 16))
+    };
+    let (cpu, gpu) = (run(ComputeBackend::Cpu), run(ComputeBackend::Wgpu));
+    assert!(gpu.data.iter().all(|v| v.is_finite()));
+    let scale = cpu.data.iter().fold(1.0f32, |m, v| m.max(v.abs()));
+    let worst = cpu.data.iter().zip(&gpu.data).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    eprintln!("wgpu vs cpu: worst difference {worst} m (values up to {scale} m)");
+    assert!(worst <= 1e-3 * scale, "wgpu differs from the CPU by {worst} m (values up to {scale} m)");
+    let _ = std::fs::remove_dir_all(&dir);
+}
