@@ -10,7 +10,7 @@ use super::Measurement;
 use crate::biome::BiomeRules;
 use crate::config::Config;
 use crate::fill::{BiomePalette, Generator, SkyLight};
-use crate::pregen::{generate, Hooks, Job, Plan, Shape, Shard, Task};
+use crate::pregen::{run_to_end, Hooks, Job, Plan, Shape, Shard, Task};
 use crate::terrain::Pipeline;
 use crate::world::codec::Encoder;
 use crate::world::{region, ChunkSource, Store};
@@ -50,19 +50,7 @@ impl Rig {
             0,
             Hooks { report_every: Duration::MAX, report: Box::new(|_| {}), on_work: Box::new(|| {}) },
         )?;
-        std::thread::scope(|scope| {
-            for _ in 0..threads {
-                let (job, source, rules) = (&job, &self.source, &self.rules);
-                scope.spawn(move || {
-                    let mut scratch = source.scratch();
-                    while let Some((n, pos)) = job.take() {
-                        generate(job, source, &mut scratch, rules, n, pos);
-                    }
-                });
-            }
-        });
-        let status = job.wait();
-        job.stop();
+        let status = run_to_end(&job, &self.source, &self.rules, threads);
         if let Some(e) = status.error {
             anyhow::bail!("pre-generation failed: {e}");
         }

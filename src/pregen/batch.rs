@@ -11,7 +11,7 @@ use clap::Args;
 
 use super::plan::{Plan, Shape, Shard, Task};
 use super::progress::{self, Progress, State};
-use super::{generate, Hooks, Job};
+use super::{run_to_end, Hooks, Job};
 use crate::biome::BiomeRules;
 use crate::cli::Failure;
 use crate::config::Config;
@@ -136,21 +136,7 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
     }
 
     let threads = args.threads.unwrap_or(config.server.chunk_threads as usize).max(1);
-    let rules = Arc::new(rules);
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            let (job, source, rules) = (&job, &source, &rules);
-            scope.spawn(move || {
-                let mut scratch = source.scratch();
-                while let Some((n, pos)) = job.take() {
-                    generate(job, source, &mut scratch, rules, n, pos);
-                }
-            });
-        }
-    });
-    let status = job.wait();
-    // Ends the checkpointer whether the task finished or paused (state saved as it is).
-    job.stop();
+    let status = run_to_end(&job, &source, &rules, threads);
     store.close().map_err(Failure::runtime)?;
     let elapsed = started.elapsed().as_secs_f64();
     match status.state {

@@ -34,3 +34,23 @@ pub fn generate(job: &Job, source: &ChunkSource, scratch: &mut Scratch, rules: &
         job.fail(failure);
     }
 }
+
+/// Works on `job` with `threads` threads of its own (no server) until nothing is left to
+/// hand out, then waits for the final state to be saved and ends the checkpointer. Returns
+/// where the job stands: finished, or paused (by an error or [`Job::pause`]).
+pub fn run_to_end(job: &Job, source: &ChunkSource, rules: &BiomeRules, threads: usize) -> Status {
+    std::thread::scope(|scope| {
+        for _ in 0..threads.max(1) {
+            scope.spawn(|| {
+                let mut scratch = source.scratch();
+                while let Some((n, pos)) = job.take() {
+                    generate(job, source, &mut scratch, rules, n, pos);
+                }
+            });
+        }
+    });
+    let status = job.wait();
+    // Ends the checkpointer whether the task finished or paused (state saved as it is).
+    job.stop();
+    status
+}
