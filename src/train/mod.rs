@@ -245,7 +245,7 @@ impl Trainer {
         let paths = CheckpointPaths { dir: args.out.join("checkpoints").join(&args.stage) };
         let optim = AdamConfig::new().with_beta_1(0.9).with_beta_2(0.99).with_epsilon(1e-8).init();
         let noise = NoiseDistribution::default();
-        let mut t = if args.resume {
+        let (net, ema, optim, state) = if args.resume {
             let text = std::fs::read_to_string(paths.state()).map_err(|e| {
                 Failure::input(anyhow!(
                     "cannot resume: {} ({e}); start a new run without --resume",
@@ -271,21 +271,7 @@ impl Trainer {
                 .load(paths.optim())
                 .map_err(|e| Failure::input(anyhow!("cannot resume from {}: {e}", paths.optim().display())))?;
             eprintln!("resuming {} at step {} (seed {})", state.stage, state.step, state.seed);
-            Trainer {
-                args: args.clone(),
-                spec_metres: spec.metres_per_pixel,
-                sampler: spec.sampler,
-                device,
-                plain,
-                net,
-                ema,
-                optim,
-                state,
-                train,
-                heldout,
-                noise,
-                paths,
-            }
+            (net, ema, optim, state)
         } else {
             let normalisation = train.normalisation(args.crop, spec.config.sigma_data);
             let net = UNet::new(&spec.config, seed, &device);
@@ -305,21 +291,22 @@ impl Trainer {
                 losses: Vec::new(),
                 validation: Vec::new(),
             };
-            Trainer {
-                args: args.clone(),
-                spec_metres: spec.metres_per_pixel,
-                sampler: spec.sampler,
-                device,
-                plain,
-                net,
-                ema,
-                optim,
-                state,
-                train,
-                heldout,
-                noise,
-                paths,
-            }
+            (net, ema, optim, state)
+        };
+        let mut t = Trainer {
+            args: args.clone(),
+            spec_metres: spec.metres_per_pixel,
+            sampler: spec.sampler,
+            device,
+            plain,
+            net,
+            ema,
+            optim,
+            state,
+            train,
+            heldout,
+            noise,
+            paths,
         };
         // A resumed run keeps its batch, crop and schedule: they define which samples each
         // step sees, and changing them would silently make it a different run.
