@@ -20,7 +20,7 @@ use image::Rgb;
 
 pub use data::DataArgs;
 pub use input::{Heightmap, Reference};
-pub use report::Report;
+pub use report::{Report, Target};
 
 use crate::terrain::metrics::{fbm, Raster, SeamLines, FBM_BETA};
 use crate::terrain::pipeline::MODEL_PIXEL_METRES;
@@ -47,6 +47,10 @@ pub struct EvalArgs {
     /// apart (32 = the pipeline's window stride).
     #[arg(long, default_value_t = 32)]
     pub seam_stride: usize,
+    /// Model manifest (e.g. `models/core.json`) whose `realism` numbers are replaced by this
+    /// report's generated values and realism bar (needs a reference with a train split).
+    #[arg(long)]
+    pub record: Option<PathBuf>,
 }
 
 /// Why an evaluation failed.
@@ -123,7 +127,39 @@ pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report
     let table = Report::new(notes, &columns, &format!("lines every {:.0} km", stride_metres / 1000.0));
     let image = plot::draw(&table.notes, &[report::slope_panel(&columns), report::spectrum_panel(&columns)]);
     save(&image, &args.out)?;
+    if let Some(manifest) = &args.record {
+        record(manifest, &table)?;
+    }
     Ok(table)
+}
+
+/// Replaces the `realism` object of the JSON manifest at `path` with the report's realism bar
+/// (value, range, verdict per metric), keeping every other field as it is.
+fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
+    if report.targets.is_empty() {
+        return Err(EvalError::Input(format!(
+            "--record {}: the reference has no train split, so there is no real-vs-real floor to record against",
+            path.display()
+        )));
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| EvalError::Input(format!("--record {}: cannot read it: {e}", path.display())))?;
+    let mut manifest: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| EvalError::Input(format!("--record {}: not JSON: {e}", path.display())))?;
+    let Some(object) = manifest.as_object_mut() else {
+        return Err(EvalError::Input(format!("--record {}: not a JSON object", path.display())));
+    };
+    let mut realism = serde_json::Map::new();
+    for t in &report.targets {
+        realism.insert(t.key.clone(), serde_json::json!(t.value));
+        realism.insert(format!("{}_met", t.key), serde_json::json!(if t.pass { 1.0 } else { 0.0 }));
+    }
+    object.insert("realism".into(), serde_json::Value::Object(realism));
+    let tmp = path.with_extension("json.tmp");
+    let out = serde_json::to_string_pretty(&manifest).expect("JSON values serialise");
+    std::fs::write(&tmp, out + "\n")
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|e| EvalError::Input(format!("--record {}: cannot write it: {e}", path.display())))
 }
 
 /// The generated map's seam sums on its own window lines (whole map: its origin places the

@@ -30,6 +30,73 @@ pub struct Report {
     pub columns: Vec<String>,
     /// (metric, one cell per column).
     pub rows: Vec<(String, Vec<String>)>,
+    /// The realism bar of the learned terrain, when the real-vs-real floor is known.
+    pub targets: Vec<Target>,
+}
+
+/// One line of the realism bar (issue #4): a generated number and the range it must lie in.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Target {
+    /// Short metric key (also the key recorded in a model manifest).
+    pub key: String,
+    /// The generated terrain's value.
+    pub value: f64,
+    /// Allowed range (inclusive).
+    pub low: f64,
+    /// Allowed range (inclusive).
+    pub high: f64,
+    /// How the range was set.
+    pub rule: String,
+    /// Whether the value lies in the range.
+    pub pass: bool,
+}
+
+impl Target {
+    fn new(key: &str, value: f64, (low, high): (f64, f64), rule: String) -> Target {
+        let pass = value.is_finite() && value >= low && value <= high;
+        Target { key: key.into(), value, low, high, rule, pass }
+    }
+
+    /// A distance to the reference: at most 2× the real-vs-real floor and at most one fifth
+    /// of the fBm baseline's distance.
+    fn distance(key: &str, generated: f64, floor: f64, fbm: f64) -> Target {
+        let high = (2.0 * floor).min(fbm / 5.0);
+        Target::new(key, generated, (0.0, high), format!("≤ min(2 × floor {floor:.3}, fBm {fbm:.3} / 5)"))
+    }
+}
+
+/// The realism bar from columns (reference, generated, fBm, train (real)).
+fn targets(columns: &[Column], slope_edges: &[f64], relief_edges: &[f64]) -> Vec<Target> {
+    let [reference, generated, fbm, train] = match columns {
+        [r, g, f, t] => [&r.metrics, &g.metrics, &f.metrics, &t.metrics],
+        _ => return Vec::new(),
+    };
+    let slope_ref = histogram(&reference.slopes, slope_edges);
+    let relief_ref = histogram(&reference.relief, relief_edges);
+    type Distance = fn(&SetMetrics, &SetMetrics, &[f64], &[f64], &[f64], &[f64]) -> f64;
+    let metrics: [(&str, Distance); 5] = [
+        ("slope_w1_deg", |m, r, _, _, _, _| wasserstein1(&m.slopes, &r.slopes)),
+        ("slope_chi2", |m, _, se, sr, _, _| chi2_distance(&histogram(&m.slopes, se), sr)),
+        ("relative_elevation_w1_m", |m, r, _, _, _, _| wasserstein1(&m.relief, &r.relief)),
+        ("relative_elevation_chi2", |m, _, _, _, re, rr| chi2_distance(&histogram(&m.relief, re), rr)),
+        ("spectral_slope_abs_delta", |m, r, _, _, _, _| (m.beta - r.beta).abs()),
+    ];
+    let mut out: Vec<Target> = metrics
+        .iter()
+        .map(|(key, d)| {
+            let d = |m: &SetMetrics| d(m, reference, slope_edges, &slope_ref, relief_edges, &relief_ref);
+            Target::distance(key, d(generated), d(train), d(fbm))
+        })
+        .collect();
+    let real = reference.depressions.per_1000_km2();
+    out.push(Target::new(
+        "depressions_per_1000_km2",
+        generated.depressions.per_1000_km2(),
+        (real / 2.0, real * 2.0),
+        format!("within 2× of real {real:.2}"),
+    ));
+    out.push(Target::new("seam_ratio", generated.seams.ratio(), (0.9, 1.1), "0.9–1.1".into()));
+    out
 }
 
 fn cell(v: f64, decimals: usize) -> String {
@@ -78,7 +145,8 @@ impl Report {
             ("fill volume per area (m³/km²)".into(), value(&|m| cell(m.depressions.volume_per_km2(), 0))),
             (format!("seam ratio ({seam_caption})"), value(&|m| cell(m.seams.ratio(), 3))),
         ];
-        Report { notes, columns: columns.iter().map(|c| c.label.clone()).collect(), rows }
+        let targets = targets(columns, &slope_edges, &relief_edges);
+        Report { notes, columns: columns.iter().map(|c| c.label.clone()).collect(), rows, targets }
     }
 
     /// The cell of `metric` in column `column`, if both exist (for tests and scripts).
@@ -110,6 +178,14 @@ impl fmt::Display for Report {
                 write!(f, "  {c:>w$}")?;
             }
             writeln!(f)?;
+        }
+        if !self.targets.is_empty() {
+            let passed = self.targets.iter().filter(|t| t.pass).count();
+            writeln!(f, "\nrealism bar (generated): {passed}/{} met", self.targets.len())?;
+            for t in &self.targets {
+                let verdict = if t.pass { "met" } else { "NOT met" };
+                writeln!(f, "  {:<26} {:>12.4}  {:<8} {}", t.key, t.value, verdict, t.rule)?;
+            }
         }
         Ok(())
     }

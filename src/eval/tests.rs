@@ -32,7 +32,49 @@ fn write_generated(path: &Path, side: usize) {
 }
 
 fn args(generated: &Path, reference: &Path, out: &Path) -> EvalArgs {
-    EvalArgs { generated: generated.into(), reference: reference.into(), out: out.into(), seam_stride: 32 }
+    EvalArgs {
+        generated: generated.into(),
+        reference: reference.into(),
+        out: out.into(),
+        seam_stride: 32,
+        record: None,
+    }
+}
+
+#[test]
+fn the_realism_bar_passes_real_terrain_fails_rougher_terrain_and_is_recorded_in_a_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = dir.path().join("core");
+    std::fs::create_dir(&set).unwrap();
+    write_split(&set, "heldout", 3, 64, 1);
+    write_split(&set, "train", 3, 64, 10);
+    // "Generated" = the held-out tiles themselves: every distance is 0.
+    let same = dir.path().join("same.npy");
+    std::fs::copy(set.join("heldout.npy"), &same).unwrap();
+    std::fs::copy(set.join("heldout.json"), same.with_extension("json")).unwrap();
+    let manifest = dir.path().join("core.json");
+    std::fs::write(&manifest, r#"{"stage": "core", "realism": {"old": 1.0}}"#).unwrap();
+    let mut a = args(&same, &set, &dir.path().join("a.png"));
+    a.record = Some(manifest.clone());
+    let report = run(&a, &mut |_, _| {}).unwrap();
+    let slope = report.targets.iter().find(|t| t.key == "slope_w1_deg").expect("slope target");
+    assert!(slope.pass && slope.value == 0.0, "{slope:?}");
+    assert!(report.to_string().contains("realism bar (generated)"), "{report}");
+    let written: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&manifest).unwrap()).unwrap();
+    assert_eq!(written["stage"], "core", "other fields are kept");
+    assert_eq!(written["realism"]["slope_w1_deg"], 0.0);
+    assert_eq!(written["realism"]["slope_w1_deg_met"], 1.0);
+    assert!(written["realism"].get("old").is_none(), "old numbers are replaced");
+
+    // Ten times the relief: slopes far off, the bar is not met.
+    let rough = dir.path().join("rough.npy");
+    let data: Vec<f32> = (0..3).flat_map(|i| hills(64, 64, 1000.0, 1 + i).data).map(|v| 10.0 * (v - 800.0)).collect();
+    write_npy_f32(&rough, (3 * 64, 64), &data).unwrap();
+    std::fs::copy(set.join("heldout.json"), rough.with_extension("json")).unwrap();
+    let report = run(&args(&rough, &set, &dir.path().join("b.png")), &mut |_, _| {}).unwrap();
+    let slope = report.targets.iter().find(|t| t.key == "slope_w1_deg").expect("slope target");
+    assert!(!slope.pass, "{slope:?}");
+    assert!(report.to_string().contains("NOT met"), "{report}");
 }
 
 #[test]

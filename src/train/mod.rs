@@ -26,7 +26,7 @@ use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
 use infiniterra_terrain::model::{
     edm_loss, force_normalize, save_model, ComputeBackend, DataChecksum, ModelManifest, NoiseDistribution,
-    Normalisation, Precision, Sampler, SamplerKind, TrainingRecord, UNet, UNetConfig,
+    Normalisation, Precision, Sampler, TrainingRecord, UNet, UNetConfig,
 };
 use serde::{Deserialize, Serialize};
 
@@ -123,7 +123,7 @@ fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, Failure> {
         "core" => Ok(StageSpec {
             metres_per_pixel: 1000.0,
             config: if smoke { UNetConfig::tiny() } else { UNetConfig::core() },
-            sampler: Sampler::karras(SamplerKind::Euler, 4, 0.05, 80.0, 7.0),
+            sampler: Sampler::few_step(),
         }),
         "coarse" | "detail" => Err(Failure::input(anyhow!(
             "stage `{stage}` is not trainable yet (issue #4 starts with `core`); trainable: core"

@@ -19,9 +19,9 @@ const GAP: usize = 4;
 /// The sampler settings compared on each sheet.
 fn samplers() -> Vec<(&'static str, Sampler)> {
     vec![
-        ("euler4", Sampler::karras(SamplerKind::Euler, 4, 0.05, 80.0, 7.0)),
-        ("renoise4", Sampler::karras(SamplerKind::Renoise, 4, 0.05, 80.0, 7.0)),
-        ("euler8", Sampler::karras(SamplerKind::Euler, 8, 0.02, 80.0, 7.0)),
+        ("shipped: dpm++2m 4", Sampler::few_step()),
+        ("euler 4", Sampler::karras(SamplerKind::Euler, 4, 0.05, 80.0, 7.0)),
+        ("euler 24", Sampler::karras(SamplerKind::Euler, 24, 0.02, 80.0, 7.0)),
     ]
 }
 

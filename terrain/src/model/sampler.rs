@@ -19,6 +19,11 @@ pub enum SamplerKind {
     /// Denoise, then re-noise with fresh noise to σᵢ₊₁: `x ← D + σᵢ₊₁·nᵢ₊₁` (the
     /// multistep sampler of consistency models). Sharper than Euler at 2–4 steps.
     Renoise,
+    /// DPM-Solver++(2M) (Lu et al. 2022): the Euler step on a denoised estimate extrapolated
+    /// linearly in log σ from the previous step's. Second order at no extra network call, so
+    /// 4–8 steps reach what Euler needs 20+ for. Uses only the initial noise.
+    #[serde(rename = "dpmpp2m")]
+    DpmPp2m,
 }
 
 /// A step rule and its noise levels (descending; a final σ = 0 is implied).
@@ -42,6 +47,14 @@ impl Sampler {
         Sampler { kind, sigmas }
     }
 
+    /// The shipped stages' sampler: DPM-Solver++(2M), 4 network calls from σ = 10 (the
+    /// residual's σ_data is 0.5, so higher levels add nothing) to 0.02. On the core model's
+    /// held-out tiles it matches real slope and spectrum far better than 4 Euler steps, and
+    /// than 6–24 steps, which over-roughen (measured in issue #4's notes).
+    pub fn few_step() -> Sampler {
+        Sampler::karras(SamplerKind::DpmPp2m, 4, 0.02, 10.0, 7.0)
+    }
+
     /// Denoiser evaluations per sample.
     pub fn steps(&self) -> usize {
         self.sigmas.len()
@@ -50,7 +63,7 @@ impl Sampler {
     /// How many standard-normal tensors [`Sampler::sample`] consumes.
     pub fn noises_needed(&self) -> usize {
         match self.kind {
-            SamplerKind::Euler => 1,
+            SamplerKind::Euler | SamplerKind::DpmPp2m => 1,
             SamplerKind::Renoise => self.sigmas.len(),
         }
     }
@@ -84,6 +97,7 @@ impl Sampler {
         let device = noise[0].device();
         let level = |s: f32| Tensor::<1>::from_data(TensorData::new(vec![s; b], [b]), &device);
         let mut x = noise[0].clone().mul_scalar(self.sigmas[0]);
+        let mut previous: Option<Tensor<4>> = None;
         for (i, &sigma) in self.sigmas.iter().enumerate() {
             let denoised = net.denoise(x.clone(), level(sigma), cond.clone(), vector.clone());
             x = match self.sigmas.get(i + 1) {
@@ -91,6 +105,20 @@ impl Sampler {
                 Some(&next) => match self.kind {
                     SamplerKind::Euler => denoised.clone() + (x - denoised).mul_scalar(next / sigma),
                     SamplerKind::Renoise => denoised + noise[i + 1].clone().mul_scalar(next),
+                    SamplerKind::DpmPp2m => {
+                        // h = step length in log σ; r = previous step's length / h.
+                        let estimate = match (&previous, i.checked_sub(1).map(|j| self.sigmas[j])) {
+                            (Some(old), Some(before)) => {
+                                let h = (sigma / next).ln();
+                                let r = (before / sigma).ln() / h;
+                                let k = 1.0 / (2.0 * r);
+                                denoised.clone().mul_scalar(1.0 + k) - old.clone().mul_scalar(k)
+                            }
+                            _ => denoised.clone(),
+                        };
+                        previous = Some(denoised);
+                        estimate.clone() + (x - estimate).mul_scalar(next / sigma)
+                    }
                 },
             };
         }

@@ -130,7 +130,7 @@ fn perturbed_tiny(seed: u64) -> UNet {
 fn the_sampler_is_deterministic_for_fixed_noise() {
     let net = perturbed_tiny(4);
     let (noise, cond, vector) = fixed_inputs(2);
-    for kind in [SamplerKind::Euler, SamplerKind::Renoise] {
+    for kind in [SamplerKind::Euler, SamplerKind::Renoise, SamplerKind::DpmPp2m] {
         let sampler = Sampler::karras(kind, 3, 0.05, 40.0, 7.0);
         let a = values(sampler.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
         let b = values(sampler.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
@@ -141,6 +141,28 @@ fn the_sampler_is_deterministic_for_fixed_noise() {
     assert_eq!(s.sigmas.len(), 4);
     assert!((s.sigmas[0] - 80.0).abs() < 1e-3 && (s.sigmas[3] - 0.002).abs() < 1e-5);
     assert!(s.validate().is_ok());
+}
+
+/// With the untrained network (out_gain = 0) the denoiser is D(x; σ) = x·σd²/(σ²+σd²), whose
+/// probability-flow ODE dx/dσ = (x − D)/σ has the exact solution x(σ) ∝ √(σ² + σd²). The
+/// second-order sampler must land much closer to it than Euler with the same steps.
+#[test]
+fn dpm_solver_is_more_accurate_than_euler_at_equal_steps() {
+    let net = UNet::new(&UNetConfig::tiny(), 3, &device());
+    let sd = net.config.sigma_data as f64;
+    let noise = vec![Tensor::<4>::ones([1, 1, 16, 16], &device())];
+    let (cond, vector) = (randn([1, 1, 16, 16], 31), Tensor::<2>::zeros([1, 2], &device()));
+    let error = |kind| {
+        let s = Sampler::karras(kind, 4, 0.02, 10.0, 7.0);
+        let (first, last) = (s.sigmas[0] as f64, *s.sigmas.last().unwrap() as f64);
+        // Exact ODE value at the last level, then the final denoising step.
+        let exact =
+            first * ((last * last + sd * sd) / (first * first + sd * sd)).sqrt() * sd * sd / (last * last + sd * sd);
+        let got = values(s.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
+        got.iter().map(|&v| (v as f64 - exact).abs() / exact).fold(0.0, f64::max)
+    };
+    let (euler, dpm) = (error(SamplerKind::Euler), error(SamplerKind::DpmPp2m));
+    assert!(dpm < euler / 3.0, "relative error: DPM-Solver++(2M) {dpm:.4}, Euler {euler:.4}");
 }
 
 fn manifest_for(net: &UNet) -> ModelManifest {
