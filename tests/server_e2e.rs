@@ -219,6 +219,83 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
+/// Asserts every column the surveyor reported is what `generator` computes with `rules` (top
+/// block, its Y, biome, sky light); returns how many were land.
+fn assert_surveyed_columns(report: &Value, columns: &[(i64, i64)], generator: &Generator, rules: &BiomeRules) -> usize {
+    let v = *generator.vertical();
+    let seen = report["columns"].as_array().expect("columns");
+    assert_eq!(seen.len(), columns.len());
+    let mut land = 0;
+    for (c, &(x, z)) in seen.iter().zip(columns) {
+        let s = generator.surface(rules, x, z);
+        let y = c["y"].as_i64().expect("y");
+        if s.y >= v.water_top_y() {
+            land += 1;
+            assert_eq!(y, i64::from(s.y), "top of column ({x}, {z}): {c}");
+            assert_eq!(c["block"], s.top, "ground block of ({x}, {z})");
+            assert_eq!(c["biome"], short(&s.biome), "biome at ({x}, {}, {z})", s.y);
+            // Sky light: open sky above the ground (unless a tree shades it), dark inside it.
+            if c["covered"] == false {
+                assert_eq!(c["sky_light_above"], 15, "{c}");
+            }
+            assert_eq!(c["sky_light_at"], 0, "{c}");
+        } else {
+            assert_eq!(y, i64::from(v.water_top_y()), "sea surface at ({x}, {z}): {c}");
+            assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
+            // One level less per block of water or ice.
+            assert_eq!(c["sky_light_above"], 15, "{c}");
+            assert_eq!(c["sky_light_at"], 14, "{c}");
+            assert_eq!(c["sky_light_below"], 13, "{c}");
+        }
+    }
+    land
+}
+
+/// Columns every 7 blocks in a 43×43 square around a spawn, and their `--columns` argument.
+fn columns_around(spawn: (i64, i64)) -> (Vec<(i64, i64)>, String) {
+    let mut columns = Vec::new();
+    for dz in (-21..=21).step_by(7) {
+        for dx in (-21..=21).step_by(7) {
+            columns.push((spawn.0 + dx, spawn.1 + dz));
+        }
+    }
+    let list = columns.iter().map(|(x, z)| format!("{x},{z}")).collect::<Vec<_>>().join(";");
+    (columns, list)
+}
+
+#[test]
+fn the_shipped_learned_core_stage_serves_the_terrain_this_process_computes() {
+    // The engine section of the shipped configuration, with the shipped weights.
+    let shipped = Config::load(&repo().join("config/server.toml")).expect("shipped config loads");
+    assert!(shipped.engine.learned.iter().any(|s| s == "core"), "the shipped config runs the learned core");
+    let biomes = repo().join("biomes");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let world = format!(
+        "directory = {:?}\n\n[engine]\nlearned = [\"core\"]\nmodels = {:?}\n",
+        dir.path().join("world").display().to_string(),
+        repo().join("models").display().to_string()
+    );
+    let mut server = Server::start_with(&biomes, 7, dir, &world);
+    let rules = load_rules(&biomes);
+    // Built here with one engine thread (the server runs two): the same bits whatever the
+    // thread count.
+    let mut terrain = server.config.terrain();
+    terrain.engine.threads = 1;
+    let pipeline = Pipeline::build(server.config.world.seed, &terrain).expect("learned pipeline builds");
+    assert!(pipeline.active_stages().iter().any(|s| s == "core"), "{:?}", pipeline.active_stages());
+    let generator = Generator::new(Arc::new(pipeline), &server.config);
+    let spawn = find_spawn(&generator, &rules);
+    let (columns, list) = columns_around((i64::from(spawn.block.x), i64::from(spawn.block.z)));
+    let expected_chunks = ChunkView::new(ChunkPos::new(0, 0), VIEW).iter().count();
+    let report =
+        server.probe("surveyor", &["--columns".into(), list, "--expect-chunks".into(), expected_chunks.to_string()]);
+    assert_eq!(report["spawn"]["y"].as_f64(), Some(spawn.feet.y), "{report}");
+    let land = assert_surveyed_columns(&report, &columns, &generator, &rules);
+    assert!(land > 0, "no land column sampled around the spawn");
+    server.expect_line(|l| l == "surveyor left", LINE_TIMEOUT);
+    assert!(server.stop().success());
+}
+
 #[test]
 fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
     let biomes = repo().join("biomes");
@@ -228,13 +305,7 @@ fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
     let v = *generator.vertical();
     let spawn = find_spawn(&generator, &rules);
 
-    let mut columns = Vec::new();
-    for dz in (-21..=21).step_by(7) {
-        for dx in (-21..=21).step_by(7) {
-            columns.push((i64::from(spawn.block.x) + dx, i64::from(spawn.block.z) + dz));
-        }
-    }
-    let list = columns.iter().map(|(x, z)| format!("{x},{z}")).collect::<Vec<_>>().join(";");
+    let (columns, list) = columns_around((i64::from(spawn.block.x), i64::from(spawn.block.z)));
     let expected_chunks = ChunkView::new(ChunkPos::new(0, 0), VIEW).iter().count();
     let report =
         server.probe("surveyor", &["--columns".into(), list, "--expect-chunks".into(), expected_chunks.to_string()]);
@@ -262,31 +333,7 @@ fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
 
     // (b) every sampled column is what the pipeline + vertical mapping + rules say (the
     // ground under any tree).
-    let seen = report["columns"].as_array().expect("columns");
-    assert_eq!(seen.len(), columns.len());
-    let mut land = 0;
-    for (c, &(x, z)) in seen.iter().zip(&columns) {
-        let s = generator.surface(&rules, x, z);
-        let y = c["y"].as_i64().expect("y");
-        if s.y >= v.water_top_y() {
-            land += 1;
-            assert_eq!(y, i64::from(s.y), "top of column ({x}, {z}): {c}");
-            assert_eq!(c["block"], s.top, "ground block of ({x}, {z})");
-            assert_eq!(c["biome"], short(&s.biome), "biome at ({x}, {}, {z})", s.y);
-            // Sky light: open sky above the ground (unless a tree shades it), dark inside it.
-            if c["covered"] == false {
-                assert_eq!(c["sky_light_above"], 15, "{c}");
-            }
-            assert_eq!(c["sky_light_at"], 0, "{c}");
-        } else {
-            assert_eq!(y, i64::from(v.water_top_y()), "sea surface at ({x}, {z}): {c}");
-            assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
-            // One level less per block of water or ice.
-            assert_eq!(c["sky_light_above"], 15, "{c}");
-            assert_eq!(c["sky_light_at"], 14, "{c}");
-            assert_eq!(c["sky_light_below"], 13, "{c}");
-        }
-    }
+    let land = assert_surveyed_columns(&report, &columns, &generator, &rules);
     assert!(land > 0, "no land column sampled around the spawn");
 
     server.expect_line(|l| l == "surveyor left", LINE_TIMEOUT);
@@ -406,7 +453,7 @@ fn start_up_problems_exit_with_a_message_and_the_documented_code() {
     let (code, stderr) = run_with(&text, &biomes);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(
-        stderr.contains("core") && (stderr.contains("--features learned") || stderr.contains("core.json")),
+        stderr.contains("core") && (stderr.contains("--no-default-features") || stderr.contains("core.json")),
         "{stderr}"
     );
 }

@@ -50,7 +50,7 @@ pub enum Command {
     /// Train a stage of the model hierarchy (`--seed` sets the training seed).
     #[cfg(feature = "learned")]
     Train(crate::train::TrainArgs),
-    /// Train a stage of the model hierarchy (needs a build with `--features learned`).
+    /// Train a stage of the model hierarchy (needs the default `learned` feature).
     #[cfg(not(feature = "learned"))]
     Train {
         /// Any further arguments.
@@ -135,8 +135,8 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Train(a) => crate::train::run(a, cli.seed),
         #[cfg(not(feature = "learned"))]
         Command::Train { .. } => Err(Failure::runtime(anyhow::anyhow!(
-            "`infiniterra train` is in this build only with the learned-model code: \
-             `cargo run --release --features learned -- train STAGE` (learned terrain is issue #4, in progress)"
+            "this binary was built without the learned-model code (--no-default-features): \
+             build with the default features (`cargo run --release -- train STAGE`)"
         ))),
         Command::Pregen(a) => crate::pregen::batch::run(&load_config(&cli)?, a),
         Command::Bench(a) => crate::bench::run(&load_config(&cli)?, a).map_err(Failure::runtime),

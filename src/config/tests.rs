@@ -12,7 +12,10 @@ fn the_shipped_config_is_valid_and_matches_the_defaults_it_documents() {
     let shipped = Config::load(&path).expect("config/server.toml must load");
     assert_eq!(shipped.layout, LayoutSettings::default());
     assert_eq!(shipped.climate, ClimateSettings::default());
-    assert_eq!(shipped.engine, EngineSettings::default());
+    // The one deliberate difference: the shipped file turns the shipped learned core on
+    // (left out, `learned` is empty: tests and tools stay procedural unless they ask).
+    assert_eq!(shipped.engine.learned, ["core"]);
+    assert_eq!(EngineSettings { learned: Vec::new(), ..shipped.engine.clone() }, EngineSettings::default());
     assert_eq!(shipped.server, ServerSettings::default());
     assert_eq!(shipped.world, WorldSettings::default());
 }

@@ -49,7 +49,9 @@ pub mod channel {
 pub enum PipelineError {
     /// Learned stages were asked for in a build without the learned-model code.
     #[error(
-        "engine.learned = {0:?} needs the learned-model code: build with `cargo build --release --features learned`"
+        "engine.learned = {0:?} needs the learned-model code, which this binary was built without \
+         (--no-default-features): build with the default features (`cargo build --release`), or set \
+         `learned = []` for the procedural layout alone"
     )]
     NotBuilt(Vec<String>),
     /// A model could not be loaded (the message names the file and the command that makes it).

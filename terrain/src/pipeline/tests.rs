@@ -130,7 +130,7 @@ fn learned_stages_in_a_build_without_them_say_how_to_build() {
     let mut settings = TerrainSettings::default();
     settings.engine.learned = vec!["core".into()];
     let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
-    assert!(err.contains("core") && err.contains("--features learned"), "{err}");
+    assert!(err.contains("core") && err.contains("--no-default-features") && err.contains("learned = []"), "{err}");
 }
 
 /// The learned core stage inside the pipeline, with a small untrained network (what it
