@@ -91,6 +91,14 @@ pub struct TrainArgs {
     /// Instead of training, generate held-out counterparts into this `.npy` (see `--tiles`).
     #[arg(long)]
     pub generate_heldout: Option<PathBuf>,
+    /// Instead of training: generate the counterpart of this real square region (`.npy` at the
+    /// model's resolution, e.g. from `scripts/data/region.py`) and draw both side by side to
+    /// `--picture`.
+    #[arg(long)]
+    pub counterpart: Option<PathBuf>,
+    /// Picture written by `--counterpart`.
+    #[arg(long, default_value = "docs/core_vs_real.png")]
+    pub picture: PathBuf,
     /// Use a very small network and no data files (smoke tests of the training machinery).
     #[arg(long, hide = true)]
     pub smoke: bool,
@@ -188,6 +196,10 @@ impl CheckpointPaths {
 /// Runs `infiniterra train`.
 pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     let spec = stage_spec(&args.stage, args.smoke)?;
+    if let Some(real) = &args.counterpart {
+        return heldout::compare(&args.out, real, &args.picture, seed.unwrap_or(DEFAULT_SEED), args.backend)
+            .map_err(Failure::runtime);
+    }
     if let Some(out) = &args.generate_heldout {
         return heldout::generate(&args.out, &args.data, out, args.tiles, seed.unwrap_or(DEFAULT_SEED), args.backend)
             .map_err(Failure::runtime);

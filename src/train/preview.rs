@@ -64,7 +64,7 @@ pub fn write(path: &Path, net: &UNet, batch: &Batch, norm: &Normalisation, devic
         // One elevation range per row (from the real terrain) so panels compare directly.
         let (lo, hi) = panels[0].iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
         for (c, p) in panels.iter().enumerate() {
-            draw(&mut img, p, s, GAP + c * (panel + GAP), GAP + i * (panel + GAP), lo, hi);
+            draw(&mut img, p, s, GAP + c * (panel + GAP), GAP + i * (panel + GAP), lo, hi, ZOOM);
         }
     }
     if let Some(dir) = path.parent() {
@@ -74,8 +74,28 @@ pub fn write(path: &Path, net: &UNet, batch: &Batch, norm: &Normalisation, devic
     Ok(())
 }
 
-/// Draws one panel: hypsometric grey ramp times a hillshade from the north-west.
-fn draw(img: &mut image::RgbImage, metres: &[f32], s: usize, x0: usize, y0: usize, lo: f32, hi: f32) {
+/// Draws square `panels` (metres, `side`² each, one shared elevation range taken from the
+/// first) side by side under a `title`, at one image pixel per grid pixel.
+pub fn side_by_side(path: &Path, title: &str, panels: &[&[f32]], side: usize) -> anyhow::Result<()> {
+    let top = 28;
+    let (w, h) = (panels.len() * side + (panels.len() + 1) * GAP, top + side + GAP);
+    let mut img = image::RgbImage::from_pixel(w as u32, h as u32, image::Rgb([255, 255, 255]));
+    crate::eval::plot::text(&mut img, GAP as i64, 8, title, image::Rgb([0, 0, 0]));
+    let (lo, hi) = panels[0].iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    for (c, p) in panels.iter().enumerate() {
+        draw(&mut img, p, side, GAP + c * (side + GAP), top, lo, hi, 1);
+    }
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    img.save(path)?;
+    Ok(())
+}
+
+/// Draws one panel at `zoom` image pixels per grid pixel: hypsometric ramp times a hillshade
+/// from the north-west.
+#[allow(clippy::too_many_arguments)]
+fn draw(img: &mut image::RgbImage, metres: &[f32], s: usize, x0: usize, y0: usize, lo: f32, hi: f32, zoom: usize) {
     // Pixels are ~1 km; exaggerate slopes so low relief still reads.
     let spacing = 1000.0 / 4.0;
     let at = |y: usize, x: usize| metres[y.min(s - 1) * s + x.min(s - 1)];
@@ -90,9 +110,9 @@ fn draw(img: &mut image::RgbImage, metres: &[f32], s: usize, x0: usize, y0: usiz
             let sea = at(y, x) < 0.0;
             let base = if sea { [70.0, 110.0, 170.0] } else { [90.0 + 120.0 * t, 120.0 + 90.0 * t, 70.0 + 150.0 * t] };
             let px = image::Rgb(base.map(|c| (c * (0.35 + 0.65 * shade)).clamp(0.0, 255.0) as u8));
-            for dy in 0..ZOOM {
-                for dx in 0..ZOOM {
-                    img.put_pixel((x0 + x * ZOOM + dx) as u32, (y0 + y * ZOOM + dy) as u32, px);
+            for dy in 0..zoom {
+                for dx in 0..zoom {
+                    img.put_pixel((x0 + x * zoom + dx) as u32, (y0 + y * zoom + dy) as u32, px);
                 }
             }
         }
