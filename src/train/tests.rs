@@ -22,6 +22,8 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         backend: ComputeBackend::Cpu,
         tiles: 0,
         generate_heldout: None,
+        counterpart: None,
+        picture: PathBuf::from("unused.png"),
         smoke: true,
     }
 }
@@ -75,4 +77,29 @@ fn resuming_without_a_checkpoint_is_an_input_error() {
     assert_eq!(err.code, 2);
     assert!(err.error.to_string().contains("state.json"), "{}", err.error);
     assert!(stage_spec("canyon", false).is_err());
+}
+
+#[test]
+fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
+    let dir = tempdir("counterpart");
+    train(&smoke_args(&dir, 2, false));
+    let real = dir.join("region.npy");
+    let tile = &data::synthetic(1, 64).tiles[0];
+    let metres: Vec<f32> = tile.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h)).collect();
+    crate::export::write_npy_f32(&real, (64, 64), &metres).expect("write region");
+    let png = dir.join("pictures/side.png");
+    heldout::compare(&dir, &real, &png, 3, ComputeBackend::Cpu).expect("counterpart");
+    let ((rows, cols), generated) =
+        crate::export::read_npy_f32(&dir.join("region_generated.npy")).expect("generated region");
+    assert_eq!((rows, cols), (64, 64));
+    assert!(generated.iter().all(|v| v.is_finite()));
+    assert_ne!(generated, metres, "generated, not copied");
+    let img = image::open(&png).expect("picture");
+    assert!(img.width() >= 3 * 64 && img.height() >= 64);
+
+    // Not a square multiple of the window: refused, naming the file.
+    crate::export::write_npy_f32(&real, (64, 32), &metres[..64 * 32]).expect("write region");
+    let err = heldout::compare(&dir, &real, &png, 3, ComputeBackend::Cpu).expect_err("not square");
+    assert!(err.to_string().contains("region.npy"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
