@@ -37,7 +37,7 @@ use infiniterra_terrain::model::burn;
 /// Arguments of `infiniterra train`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct TrainArgs {
-    /// Stage to train (`core`; `coarse` and `detail` are not trainable yet).
+    /// Stage to train (`coarse` or `core`; `detail` is not trainable yet).
     pub stage: String,
     /// Total optimiser steps (a resumed run continues up to this count).
     #[arg(long, default_value_t = 4000)]
@@ -133,18 +133,24 @@ fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, Failure> {
             config: if smoke { UNetConfig::tiny() } else { UNetConfig::core() },
             sampler: Sampler::few_step(),
         }),
-        "coarse" | "detail" => Err(Failure::input(anyhow!(
-            "stage `{stage}` is not trainable yet (issue #4 starts with `core`); trainable: core"
-        ))),
+        // The same network one level up: 8 km relief (continents, shelves, basins) from the
+        // 64 km means of the layout.
+        "coarse" => Ok(StageSpec {
+            metres_per_pixel: 8000.0,
+            config: if smoke { UNetConfig::tiny() } else { UNetConfig::core() },
+            sampler: Sampler::few_step(),
+        }),
+        "detail" => Err(Failure::input(anyhow!("stage `detail` is not trainable yet; trainable: coarse, core"))),
         _ => Err(Failure::input(anyhow!("unknown stage `{stage}` (stages: coarse, core, detail)"))),
     }
 }
 
-/// Loads the core stage's data: the GLOBE 1 km tiles, train and held-out. The 500 m GEBCO
-/// tiles are not added (downsampled): they cover Kyrgyzstan, inside the core set's held-out
-/// band (60–90°E), so training on them would leak held-out terrain into the model.
-fn core_data(dir: &Path) -> Result<(TileSet, TileSet), String> {
-    Ok((read_split(&dir.join("core"), "train", 1)?, read_split(&dir.join("core"), "heldout", 1)?))
+/// Loads a stage's prepared set (`<dir>/<stage>/`), train and held-out: ETOPO5 8 km tiles for
+/// coarse, GLOBE 1 km tiles for core. The 500 m GEBCO tiles are not added to the core's
+/// (downsampled): they cover Kyrgyzstan, inside the core set's held-out band (60–90°E), so
+/// training on them would leak held-out terrain into the model.
+fn stage_data(stage: &str, dir: &Path) -> Result<(TileSet, TileSet), String> {
+    Ok((read_split(&dir.join(stage), "train", 1)?, read_split(&dir.join(stage), "heldout", 1)?))
 }
 
 /// What a checkpoint records besides tensors.
@@ -191,11 +197,19 @@ impl CheckpointPaths {
 pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     let spec = stage_spec(&args.stage, args.smoke)?;
     if let Some(real) = &args.counterpart {
-        return heldout::compare(&args.out, real, &args.picture, seed.unwrap_or(DEFAULT_SEED), args.backend)
-            .map_err(Failure::runtime);
+        return heldout::compare(
+            &args.out,
+            &args.stage,
+            real,
+            &args.picture,
+            seed.unwrap_or(DEFAULT_SEED),
+            args.backend,
+        )
+        .map_err(Failure::runtime);
     }
     if let Some(out) = &args.generate_heldout {
-        return heldout::generate(&args.out, &args.data, out, args.tiles, seed.unwrap_or(DEFAULT_SEED), args.backend)
+        let seed = seed.unwrap_or(DEFAULT_SEED);
+        return heldout::generate(&args.out, &args.stage, &args.data, out, args.tiles, seed, args.backend)
             .map_err(Failure::runtime);
     }
     if args.crop == 0 || args.crop % spec.config.size_multiple().max(8) != 0 {
@@ -207,7 +221,7 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     let (train, heldout) = if args.smoke {
         (data::synthetic(6, 128), data::synthetic(2, 128))
     } else {
-        core_data(&args.data).map_err(|e| Failure::input(anyhow!(e)))?
+        stage_data(&args.stage, &args.data).map_err(|e| Failure::input(anyhow!(e)))?
     };
     if train.min_tile() < args.crop {
         return Err(Failure::input(anyhow!("--crop {} exceeds the smallest tile ({})", args.crop, train.min_tile())));

@@ -88,7 +88,7 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
     let metres: Vec<f32> = tile.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h)).collect();
     crate::export::write_npy_f32(&real, (64, 64), &metres).expect("write region");
     let png = dir.join("pictures/side.png");
-    heldout::compare(&dir, &real, &png, 3, ComputeBackend::Cpu).expect("counterpart");
+    heldout::compare(&dir, "core", &real, &png, 3, ComputeBackend::Cpu).expect("counterpart");
     let ((rows, cols), generated) =
         crate::export::read_npy_f32(&dir.join("region_generated.npy")).expect("generated region");
     assert_eq!((rows, cols), (64, 64));
@@ -99,7 +99,7 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
 
     // Not a square multiple of the window: refused, naming the file.
     crate::export::write_npy_f32(&real, (64, 32), &metres[..64 * 32]).expect("write region");
-    let err = heldout::compare(&dir, &real, &png, 3, ComputeBackend::Cpu).expect_err("not square");
+    let err = heldout::compare(&dir, "core", &real, &png, 3, ComputeBackend::Cpu).expect_err("not square");
     assert!(err.to_string().contains("region.npy"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

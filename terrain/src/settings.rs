@@ -49,7 +49,7 @@ pub struct EngineSettings {
 }
 
 /// Learned stages that exist (have code and can be trained).
-pub const LEARNED_STAGES: [&str; 1] = ["core"];
+pub const LEARNED_STAGES: [&str; 2] = ["coarse", "core"];
 
 impl Default for EngineSettings {
     fn default() -> Self {

@@ -1,7 +1,7 @@
 //! Learned stages as window functions of the infinite-tensor engine.
 //!
-//! [`CoreStage`] runs the core model on 64×64 windows (stride 32: ≈50 % overlap) of its own
-//! grid. Its conditioning is a field 8× coarser than that grid (the coarse stage, or the
+//! [`LearnedStage`] runs a stage's model (coarse or core) on 64×64 windows (stride 32: ≈50 %
+//! overlap) of its own grid. Its conditioning is a field 8× coarser than that grid (the coarse stage, or the
 //! layout standing in for it), bilinearly upsampled from globally aligned cells so every
 //! window sees the same values where windows overlap. Its noise comes from
 //! [`GaussianNoise`] keyed by (seed, stage, sampler step, global tile), so the result is a pure
@@ -20,11 +20,21 @@ use crate::noise::{GaussianNoise, NoiseKey};
 use crate::tile::{Rect, Tile};
 use crate::upsample;
 
-/// Noise stream number of the core stage (each stage has its own).
-pub const CORE_NOISE_STAGE: u32 = 2;
+/// Noise stream number of a stage (each stage draws its own noise, so two stages never
+/// see correlated noise): coarse 1, core 2, detail 3.
+pub fn noise_stream(stage: &str) -> u32 {
+    match stage {
+        "coarse" => 1,
+        "core" => 2,
+        "detail" => 3,
+        _ => 15,
+    }
+}
 
-/// The core model as a [`WindowFn`]: elevation in metres (one channel) on its grid.
-pub struct CoreStage {
+/// A learned stage's model as a [`WindowFn`]: elevation in metres (one channel) on its grid,
+/// generated as the residual over a context 8× coarser.
+pub struct LearnedStage {
+    name: String,
     net: UNet,
     device: Device,
     sampler: Sampler,
@@ -36,13 +46,14 @@ pub struct CoreStage {
     batch: usize,
 }
 
-impl CoreStage {
-    /// The core stage of world `seed`: `model` on `device`, conditioned on `coarse` (elevation
-    /// in metres on a grid [`LAPLACIAN_FACTOR`]× coarser than the output), windows of the
-    /// model's size with half-window stride, `batch` windows per network call.
-    pub fn new(model: LoadedModel, device: Device, coarse: Arc<dyn Source>, seed: u64, batch: usize) -> CoreStage {
+impl LearnedStage {
+    /// The stage `model.manifest.stage` of world `seed`: `model` on `device`, conditioned on
+    /// `coarse` (elevation in metres on a grid [`LAPLACIAN_FACTOR`]× coarser than the output),
+    /// windows of the model's size with half-window stride, `batch` windows per network call.
+    pub fn new(model: LoadedModel, device: Device, coarse: Arc<dyn Source>, seed: u64, batch: usize) -> LearnedStage {
         let window = model.manifest.window as i64;
-        CoreStage {
+        LearnedStage {
+            name: model.manifest.stage.clone(),
             sampler: model.manifest.sampler.clone(),
             norm: model.manifest.normalisation.clone(),
             net: model.net,
@@ -67,9 +78,9 @@ impl CoreStage {
     }
 }
 
-impl WindowFn for CoreStage {
+impl WindowFn for LearnedStage {
     fn name(&self) -> &str {
-        "core"
+        &self.name
     }
 
     fn channels(&self) -> usize {
@@ -99,7 +110,7 @@ impl WindowFn for CoreStage {
         let noises: Vec<Tensor<4>> = (0..self.sampler.noises_needed())
             .map(|step| {
                 let source = GaussianNoise {
-                    key: NoiseKey { seed: self.seed, stage: CORE_NOISE_STAGE, step: step as u32 },
+                    key: NoiseKey { seed: self.seed, stage: noise_stream(&self.name), step: step as u32 },
                     channels: 1,
                 };
                 let mut values = Vec::with_capacity(b * n);

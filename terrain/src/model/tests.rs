@@ -3,7 +3,7 @@ use std::sync::Arc;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
 
-use super::stage::CoreStage;
+use super::stage::LearnedStage;
 use super::*;
 use crate::infinite::{Engine, EngineConfig, Source, Windowed};
 use crate::tile::{Rect, Tile};
@@ -277,13 +277,13 @@ impl Source for Hills {
     }
 }
 
-fn tiny_core(batch: usize) -> CoreStage {
+fn tiny_core(batch: usize) -> LearnedStage {
     let net = perturbed_tiny(11);
     let mut manifest = manifest_for(&net);
     manifest.window = 32;
     manifest.normalisation =
         Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
-    CoreStage::new(LoadedModel { net, manifest }, device(), Arc::new(Hills), 42, batch)
+    LearnedStage::new(LoadedModel { net, manifest }, device(), Arc::new(Hills), 42, batch)
 }
 
 #[test]
@@ -329,7 +329,7 @@ fn bench_core_windows_per_second() {
             Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
         let model = LoadedModel { net: UNet::new(&UNetConfig::core(), 0, &device()), manifest };
         let engine = Engine::new(EngineConfig { cache_bytes: 256 << 20, threads: 2 });
-        let tensor = Windowed::new(&engine, CoreStage::new(model, device(), Arc::new(Hills), 1, 8));
+        let tensor = Windowed::new(&engine, LearnedStage::new(model, device(), Arc::new(Hills), 1, 8));
         let t = std::time::Instant::now();
         let _ = tensor.query(Rect::new(0, 0, 256, 256));
         let secs = t.elapsed().as_secs_f64();
@@ -357,7 +357,7 @@ fn one_core_window_on_wgpu_matches_the_cpu_backend() {
         let model = load_model(&dir, "test", &device).expect("load");
         let engine = Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 });
         // One window: a 16×16 query inside the first window's unshared core.
-        Windowed::new(&engine, CoreStage::new(model, device, Arc::new(Hills), 42, 1)).query(Rect::new(8, 8, 16, 16))
+        Windowed::new(&engine, LearnedStage::new(model, device, Arc::new(Hills), 42, 1)).query(Rect::new(8, 8, 16, 16))
     };
     let (cpu, gpu) = (run(ComputeBackend::Cpu), run(ComputeBackend::Wgpu));
     assert!(gpu.data.iter().all(|v| v.is_finite()));

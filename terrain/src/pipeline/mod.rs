@@ -12,6 +12,7 @@ use std::sync::Arc;
 pub use stages::{StageState, StageStatus};
 
 use crate::climate::{precipitation, temperature_at, Orographic};
+use crate::encoding::LAPLACIAN_FACTOR;
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::settings::TerrainSettings;
@@ -62,10 +63,61 @@ pub enum PipelineError {
     #[cfg(feature = "learned")]
     #[error(transparent)]
     Backend(#[from] crate::model::BackendError),
+    /// A model was trained at a resolution its place in the hierarchy cannot use.
+    #[error(
+        "{file}: metres_per_pixel = {found} does not fit the {stage} stage (needs {needed}); retrain it with \
+         `infiniterra train {stage}`"
+    )]
+    Resolution {
+        /// The manifest.
+        file: String,
+        /// The stage.
+        stage: String,
+        /// What the manifest says.
+        found: f64,
+        /// What the stage needs.
+        needed: String,
+    },
+}
+
+/// A grid `factor`× coarser than its source's, each cell the mean of its `factor`² source
+/// cells (the context a learned stage is conditioned on, like the Laplacian low band it was
+/// trained with).
+#[cfg_attr(not(feature = "learned"), allow(dead_code))]
+struct BoxMean {
+    source: Arc<dyn Source>,
+    factor: i64,
+}
+
+impl Source for BoxMean {
+    fn channels(&self) -> usize {
+        self.source.channels()
+    }
+
+    fn query(&self, rect: Rect) -> Tile {
+        let f = self.factor;
+        let fine = self.source.query(Rect::new(rect.y0 * f, rect.x0 * f, rect.h * f, rect.w * f));
+        let c = fine.channels;
+        let mut out = Tile::zeros(c, rect);
+        let (fw, n, fine_n) = ((rect.w * f) as usize, rect.area(), fine.rect.area());
+        let scale = 1.0 / (f * f) as f32;
+        for ch in 0..c {
+            for y in 0..rect.h as usize {
+                for x in 0..rect.w as usize {
+                    let mut sum = 0.0f32;
+                    for dy in 0..f as usize {
+                        let row = (y * f as usize + dy) * fw + x * f as usize;
+                        sum += fine.data[ch * fine_n + row..ch * fine_n + row + f as usize].iter().sum::<f32>();
+                    }
+                    out.data[ch * n + y * rect.w as usize + x] = sum * scale;
+                }
+            }
+        }
+        out
+    }
 }
 
 /// A grid `factor`× finer than its source's, by exact bilinear interpolation.
-#[cfg_attr(not(feature = "learned"), allow(dead_code))]
 struct Upsampled {
     source: Arc<dyn Source>,
     factor: i64,
@@ -109,7 +161,15 @@ impl Pipeline {
         });
         let layout = Layout::new(seed, &settings.layout);
         let coarse_metres = MODEL_PIXEL_METRES * COARSE_FACTOR as f64;
-        let coarse_elevation: Arc<dyn Source> = Arc::new(layout.elevation(coarse_metres));
+        let mut stages = stages::current();
+        let sketch_elevation: Arc<dyn Source> = Arc::new(layout.elevation(coarse_metres));
+        let coarse_elevation: Arc<dyn Source> = if settings.engine.learned.iter().any(|s| s == "coarse") {
+            // The coarse model refines the layout from its 64 km means (its Laplacian context).
+            let context = Arc::new(BoxMean { source: sketch_elevation, factor: LAPLACIAN_FACTOR as i64 });
+            learned_stage("coarse", seed, settings, &engine, context, coarse_metres, &mut stages)?
+        } else {
+            sketch_elevation
+        };
         let coarse_sketch: Arc<dyn Source> = Arc::new(layout.climate_sketch(coarse_metres));
         let precipitation = Windowed::new(
             &engine,
@@ -123,11 +183,13 @@ impl Pipeline {
                 margin: 48,
             },
         );
-        let mut stages = stages::current();
-        let elevation: Arc<dyn Source> = if settings.engine.learned.is_empty() {
+        let elevation: Arc<dyn Source> = if settings.engine.learned.iter().any(|s| s == "core") {
+            learned_stage("core", seed, settings, &engine, coarse_elevation.clone(), MODEL_PIXEL_METRES, &mut stages)?
+        } else if settings.engine.learned.is_empty() {
             Arc::new(layout.elevation(MODEL_PIXEL_METRES))
         } else {
-            learned_elevation(seed, settings, &engine, coarse_elevation.clone(), &mut stages)?
+            // Coarse alone: its relief, bilinearly brought to the model grid.
+            Arc::new(Upsampled { source: coarse_elevation.clone(), factor: COARSE_FACTOR })
         };
         Ok(Pipeline {
             seed,
@@ -221,35 +283,55 @@ impl Pipeline {
     }
 }
 
-/// The learned core stage on its 1 km grid, conditioned on the 8 km sketch, brought to the
-/// 500 m model grid (the detail stage that would add the finest relief is not trained yet).
+/// The learned stage `name` (`models/<name>.json`), conditioned on `context` (metres on a grid
+/// [`LAPLACIAN_FACTOR`]× coarser than the model's), brought to a grid of `target_metres` by
+/// exact bilinear upsampling when the model's is coarser. Marks the stage active.
 #[cfg(feature = "learned")]
-fn learned_elevation(
+fn learned_stage(
+    name: &str,
     seed: u64,
     settings: &TerrainSettings,
     engine: &Arc<Engine>,
-    coarse: Arc<dyn Source>,
+    context: Arc<dyn Source>,
+    target_metres: f64,
     stages: &mut [StageStatus],
 ) -> Result<Arc<dyn Source>, PipelineError> {
-    use crate::model::{load_model, stage::CoreStage, ComputeBackend};
+    use crate::model::{load_model, stage::LearnedStage, ComputeBackend};
     let backend: ComputeBackend = settings.engine.backend.parse()?;
     let device = backend.device()?;
-    let model = load_model(&settings.engine.models, "core", &device)?;
-    let core_metres = model.manifest.metres_per_pixel;
-    let factor = (core_metres / MODEL_PIXEL_METRES).round().max(1.0) as i64;
-    let core = Windowed::new(engine, CoreStage::new(model, device, coarse, seed, 8));
-    for s in stages.iter_mut().filter(|s| s.name == "core") {
+    let model = load_model(&settings.engine.models, name, &device)?;
+    let metres = model.manifest.metres_per_pixel;
+    let factor = (metres / target_metres).round();
+    // The core conditions on the 8 km grid (so it is trained at 1 km); the coarse model is the
+    // 8 km grid itself.
+    let needed = if name == "coarse" {
+        target_metres
+    } else {
+        MODEL_PIXEL_METRES * COARSE_FACTOR as f64 / LAPLACIAN_FACTOR as f64
+    };
+    if factor < 1.0 || (metres - needed).abs() > 1e-6 * needed {
+        return Err(PipelineError::Resolution {
+            file: settings.engine.models.join(format!("{name}.json")).display().to_string(),
+            stage: name.to_string(),
+            found: metres,
+            needed: format!("{needed} m per pixel"),
+        });
+    }
+    let stage = Windowed::new(engine, LearnedStage::new(model, device, context, seed, 8));
+    for s in stages.iter_mut().filter(|s| s.name == name) {
         s.state = StageState::Active;
     }
-    Ok(Arc::new(Upsampled { source: core, factor }))
+    Ok(if factor as i64 == 1 { stage } else { Arc::new(Upsampled { source: stage, factor: factor as i64 }) })
 }
 
 #[cfg(not(feature = "learned"))]
-fn learned_elevation(
+fn learned_stage(
+    _name: &str,
     _seed: u64,
     settings: &TerrainSettings,
     _engine: &Arc<Engine>,
-    _coarse: Arc<dyn Source>,
+    _context: Arc<dyn Source>,
+    _target_metres: f64,
     _stages: &mut [StageStatus],
 ) -> Result<Arc<dyn Source>, PipelineError> {
     Err(PipelineError::NotBuilt(settings.engine.learned.clone()))

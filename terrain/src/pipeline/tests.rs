@@ -20,6 +20,37 @@ fn shuffled<T>(mut v: Vec<T>, seed: u64) -> Vec<T> {
     v
 }
 
+/// x + 1000·y on every cell, two channels (the second negated).
+struct Ramp;
+
+impl Source for Ramp {
+    fn channels(&self) -> usize {
+        2
+    }
+
+    fn query(&self, rect: Rect) -> Tile {
+        let mut t = Tile::zeros(2, rect);
+        let n = rect.area();
+        for (i, (y, x)) in (rect.y0..rect.y1()).flat_map(|y| (rect.x0..rect.x1()).map(move |x| (y, x))).enumerate() {
+            t.data[i] = (x + 1000 * y) as f32;
+            t.data[n + i] = -t.data[i];
+        }
+        t
+    }
+}
+
+#[test]
+fn box_means_average_each_block_of_the_finer_grid() {
+    let coarse = BoxMean { source: Arc::new(Ramp), factor: 4 };
+    let t = coarse.query(Rect::new(-1, 2, 2, 3));
+    // Cell (y, x) averages fine rows 4y..4y+3 and columns 4x..4x+3: centre (4y+1.5, 4x+1.5).
+    for (i, (y, x)) in [(-1, 2), (-1, 3), (-1, 4), (0, 2), (0, 3), (0, 4)].into_iter().enumerate() {
+        let want = (4 * x) as f32 + 1.5 + 1000.0 * ((4 * y) as f32 + 1.5);
+        assert_eq!(t.data[i], want, "cell ({y}, {x})");
+        assert_eq!(t.data[6 + i], -want, "second channel of ({y}, {x})");
+    }
+}
+
 #[test]
 fn a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
     // 96×96 blocks spread over several coarse windows, far from the origin.
@@ -140,25 +171,39 @@ mod learned {
     use super::*;
     use crate::model::{save_model, ModelManifest, Normalisation, Precision, Sampler, SamplerKind, UNet, UNetConfig};
 
-    fn models_dir(name: &str) -> std::path::PathBuf {
+    /// Tiny untrained models of the core (1 km) and coarse (`coarse_metres`) stages.
+    fn models_dir(name: &str, coarse_metres: f64) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("infiniterra-pipeline-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let net = UNet::new(&UNetConfig::tiny(), 3, &burn::tensor::Device::flex());
-        let mut manifest =
-            ModelManifest::new("core", net.config.clone(), Sampler::karras(SamplerKind::Euler, 2, 0.05, 40.0, 7.0));
-        manifest.window = 32;
-        manifest.metres_per_pixel = 1000.0;
-        manifest.normalisation =
-            Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
-        save_model(&dir, &net, manifest, Precision::F32).expect("save");
+        for (stage, metres, seed) in [("core", 1000.0, 3), ("coarse", coarse_metres, 4)] {
+            let mut net = UNet::new(&UNetConfig::tiny(), seed, &burn::tensor::Device::flex());
+            // A non-zero output gain, so the untrained network changes what it is given.
+            net.out_gain = net.out_gain.map(|g| g.add_scalar(0.5));
+            let mut manifest =
+                ModelManifest::new(stage, net.config.clone(), Sampler::karras(SamplerKind::Euler, 2, 0.05, 40.0, 7.0));
+            manifest.window = 32;
+            manifest.metres_per_pixel = metres;
+            manifest.normalisation = Normalisation {
+                target_scale: 4.0,
+                cond_mean: 10.0,
+                cond_scale: 20.0,
+                relief_mean: 0.0,
+                relief_std: 1.0,
+            };
+            save_model(&dir, &net, manifest, Precision::F32).expect("save");
+        }
         dir
     }
 
     fn learned(seed: u64, models: &std::path::Path, cache_mib: u64, threads: u64) -> Pipeline {
+        learned_stages(seed, models, cache_mib, threads, &["core"])
+    }
+
+    fn learned_stages(seed: u64, models: &std::path::Path, cache_mib: u64, threads: u64, stages: &[&str]) -> Pipeline {
         let engine = EngineSettings {
             cache_mib,
             threads,
-            learned: vec!["core".into()],
+            learned: stages.iter().map(|s| s.to_string()).collect(),
             models: models.to_path_buf(),
             backend: "cpu".into(),
         };
@@ -167,7 +212,7 @@ mod learned {
 
     #[test]
     fn with_the_core_stage_a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
-        let models = models_dir("determinism");
+        let models = models_dir("determinism", 8000.0);
         let whole = Rect::new(40_000, -123_456, 64, 64);
         let reference = learned(5, &models, 256, 1);
         assert!(reference.active_stages().contains(&"core".to_string()), "{:?}", reference.active_stages());
@@ -187,6 +232,45 @@ mod learned {
         // The learned stage really shapes the terrain: not the layout's elevation.
         let procedural = pipeline(5, 256, 1).columns(whole);
         assert_ne!(procedural.channel(channel::ELEVATION), reference.channel(channel::ELEVATION));
+        let _ = std::fs::remove_dir_all(&models);
+    }
+
+    #[test]
+    fn with_coarse_and_core_a_region_is_bit_identical_and_the_coarse_model_shapes_it() {
+        let models = models_dir("coarse", 8000.0);
+        // A region spanning two 8 km coarse windows' worth of chunks.
+        let whole = Rect::new(-70_000, 52_000, 48, 48);
+        let both = learned_stages(9, &models, 256, 1, &["coarse", "core"]);
+        let active = both.active_stages();
+        assert!(active.contains(&"coarse".to_string()) && active.contains(&"core".to_string()), "{active:?}");
+        let reference = both.columns(whole);
+        assert!(reference.data.iter().all(|v| v.is_finite()));
+        let p = learned_stages(9, &models, 1, 2, &["coarse", "core"]);
+        let chunks: Vec<Rect> =
+            (0..9).map(|i| Rect::new(whole.y0 + (i / 3) * 16, whole.x0 + (i % 3) * 16, 16, 16)).collect();
+        for r in shuffled(chunks, 3) {
+            assert!(p.columns(r) == reference.crop(r), "chunk {r:?} differs (cache 1 MiB, 2 threads)");
+        }
+        // The coarse model changes the 8 km grid the climate and the core are built on.
+        let core_only = learned(9, &models, 256, 1);
+        let at = |p: &Pipeline| p.coarse_elevation_at_block(whole.x0, whole.y0);
+        assert_ne!(at(&both), at(&core_only));
+        assert_ne!(
+            both.columns(whole).channel(channel::ELEVATION),
+            core_only.columns(whole).channel(channel::ELEVATION)
+        );
+        let _ = std::fs::remove_dir_all(&models);
+    }
+
+    #[test]
+    fn a_coarse_model_of_the_wrong_resolution_is_refused_naming_its_manifest() {
+        let models = models_dir("wrong", 1000.0);
+        let settings = TerrainSettings {
+            engine: EngineSettings { learned: vec!["coarse".into()], models: models.clone(), ..Default::default() },
+            ..Default::default()
+        };
+        let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
+        assert!(err.contains("coarse.json") && err.contains("8000") && err.contains("train coarse"), "{err}");
         let _ = std::fs::remove_dir_all(&models);
     }
 
