@@ -23,6 +23,15 @@ pub use progress::{Progress, State};
 /// marks it done; a failure (a full disk, a bug) pauses the job with the reason.
 pub fn generate(job: &Job, source: &ChunkSource, scratch: &mut Scratch, rules: &BiomeRules, n: u64, pos: (i32, i32)) {
     let (x, z) = pos;
+    let plan = job.plan();
+    if plan.region_start(plan.region_index(n)) == n {
+        // Entering a region file: its learned-stage windows are evaluated now, all together in
+        // full parallel batches, instead of a few at a time as single chunks need them (where
+        // the second worker would wait on the first's window). The results are the same bits.
+        let (rx, rz) = (x.div_euclid(32), z.div_euclid(32));
+        let blocks = crate::terrain::Rect::new(i64::from(rz) * 512, i64::from(rx) * 512, 512, 512);
+        source.generator().pipeline().prefetch(blocks);
+    }
     match catch_unwind(AssertUnwindSafe(|| source.ensure_saved(scratch, rules, x, z))) {
         Ok(Ok(_)) => job.complete(n),
         Ok(Err(e)) => job.fail(e.to_string()),

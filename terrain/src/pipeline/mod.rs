@@ -274,6 +274,20 @@ impl Pipeline {
         upsample::bilinear(&model, BLOCKS_PER_MODEL_PIXEL, blocks)
     }
 
+    /// Evaluates every window (learned stages and climate) that queries inside `blocks` need
+    /// now, in full parallel batches, so those queries are cache hits (pre-generation calls it
+    /// per region file). A no-op without learned stages: then windows are cheap and the
+    /// procedural layout is computed per query anyway.
+    pub fn prefetch(&self, blocks: Rect) {
+        let learned = self
+            .stages
+            .iter()
+            .any(|s| s.state == StageState::Active && crate::settings::LEARNED_STAGES.contains(&s.name));
+        if learned {
+            self.model(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
+        }
+    }
+
     /// Coarse elevation (metres) of the coarse cell holding a block column: cheap, for
     /// searching a spawn point or a region's character without running the full pipeline.
     pub fn coarse_elevation_at_block(&self, x: i64, z: i64) -> f32 {

@@ -25,7 +25,10 @@ pub struct StageStatus {
 
 /// The hierarchy as it stands in this build.
 pub fn current() -> Vec<StageStatus> {
-    const LEARNED: &str = "learned model not trained yet (issue #4): the layout stands in";
+    // Stages a configuration can turn on (`engine.learned`) start as off; the pipeline marks
+    // the ones it loads as active.
+    const OFF: &str = "off (not in engine.learned): the layout stands in";
+    const UNTRAINED: &str = "not trainable yet (issue #4): bilinear upsampling stands in";
     vec![
         StageStatus {
             name: "layout",
@@ -35,14 +38,18 @@ pub fn current() -> Vec<StageStatus> {
         StageStatus {
             name: "coarse",
             role: "refines the sketch: continents, shelves, basins",
-            state: StageState::Missing { reason: LEARNED },
+            state: StageState::Missing { reason: OFF },
         },
         StageStatus {
             name: "core",
             role: "relief at the native resolution",
-            state: StageState::Missing { reason: LEARNED },
+            state: StageState::Missing { reason: OFF },
         },
-        StageStatus { name: "detail", role: "high-frequency residual", state: StageState::Missing { reason: LEARNED } },
+        StageStatus {
+            name: "detail",
+            role: "high-frequency residual",
+            state: StageState::Missing { reason: UNTRAINED },
+        },
         StageStatus {
             name: "climate",
             role: "lapse-rate temperature, orographic precipitation",

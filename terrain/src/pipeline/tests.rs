@@ -263,6 +263,31 @@ mod learned {
     }
 
     #[test]
+    fn after_a_prefetch_the_chunks_inside_evaluate_no_window_and_are_the_same_bits() {
+        let models = models_dir("prefetch", 8000.0);
+        let region = Rect::new(512, -1024, 512, 512);
+        let chunks: Vec<Rect> = [(0, 0), (15, 7), (31, 31), (0, 31)]
+            .iter()
+            .map(|&(cz, cx)| Rect::new(region.y0 + cz * 16, region.x0 + cx * 16, 16, 16))
+            .collect();
+        let cold = learned(2, &models, 256, 1);
+        let want: Vec<Tile> = chunks.iter().map(|&r| cold.columns(r)).collect();
+        let p = learned(2, &models, 256, 2);
+        p.prefetch(region);
+        let before = p.engine_stats().windows_evaluated;
+        assert!(before > 0, "the prefetch evaluated the region's windows");
+        for (r, w) in chunks.iter().zip(&want) {
+            assert!(p.columns(*r) == *w, "chunk {r:?} differs after a prefetch");
+        }
+        assert_eq!(p.engine_stats().windows_evaluated, before, "a chunk inside the region needed a new window");
+        // Without learned stages there is nothing to prefetch.
+        let procedural = pipeline(2, 256, 1);
+        procedural.prefetch(region);
+        assert_eq!(procedural.engine_stats().windows_evaluated, 0);
+        let _ = std::fs::remove_dir_all(&models);
+    }
+
+    #[test]
     fn a_coarse_model_of_the_wrong_resolution_is_refused_naming_its_manifest() {
         let models = models_dir("wrong", 1000.0);
         let settings = TerrainSettings {
