@@ -9,7 +9,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use infiniterra_terrain::encoding::{lowpass, signed_sqrt, signed_square, upsample_low, LAPLACIAN_FACTOR};
+use infiniterra_terrain::encoding::{
+    box_downsample, lowpass, signed_sqrt, signed_square, upsample_low, LAPLACIAN_FACTOR,
+};
 use infiniterra_terrain::infinite::{Engine, EngineConfig, Source, Windowed};
 use infiniterra_terrain::model::burn::tensor::Device;
 use infiniterra_terrain::model::stage::LearnedStage;
@@ -45,9 +47,11 @@ impl Source for ClampedGrid {
 /// The core model's terrain (metres) on an `n`×`n` grid conditioned on the low band of `h`
 /// (signed-sqrt elevations of a real tile), and the number of windows it took.
 fn counterpart(model: &LoadedModel, device: &Device, h: &[f32], n: usize, seed: u64) -> (Vec<f32>, u64) {
-    let low = lowpass(h, n, n);
+    // The stage blurs its context itself, so it is given the box means (the clamped extension
+    // then blurs exactly as training's lowpass does at tile edges).
+    let means = box_downsample(h, n, n);
     let coarse =
-        ClampedGrid { size: (n / LAPLACIAN_FACTOR) as i64, metres: low.iter().map(|&v| signed_square(v)).collect() };
+        ClampedGrid { size: (n / LAPLACIAN_FACTOR) as i64, metres: means.iter().map(|&v| signed_square(v)).collect() };
     let engine = Engine::new(EngineConfig { cache_bytes: 256 << 20, threads: 2 });
     let stage = Windowed::new(&engine, LearnedStage::new(model.clone(), device.clone(), Arc::new(coarse), seed, 8));
     let t = stage.query(Rect::new(0, 0, n as i64, n as i64));

@@ -21,8 +21,19 @@ fn downsample(x: &[f32], h: usize, w: usize, f: usize) -> Vec<f32> {
     out
 }
 
-/// Separable blur with clamped edges.
-fn blur(x: &[f32], h: usize, w: usize) -> Vec<f32> {
+/// The box-downsampled (by [`LAPLACIAN_FACTOR`]) grid of an `h × w` image, before the blur
+/// [`lowpass`] applies: what a learned stage's context source provides.
+pub fn box_downsample(x: &[f32], h: usize, w: usize) -> Vec<f32> {
+    assert!(h % LAPLACIAN_FACTOR == 0 && w % LAPLACIAN_FACTOR == 0, "{h}×{w} is not a multiple of {LAPLACIAN_FACTOR}");
+    downsample(x, h, w, LAPLACIAN_FACTOR)
+}
+
+/// Half-width of [`blur`] in cells: a context needs this many extra cells on every side.
+pub const BLUR_RADIUS: usize = 2;
+
+/// Separable 5-tap binomial blur of an `h × w` low-band grid with clamped edges (the second
+/// half of [`lowpass`]).
+pub fn blur(x: &[f32], h: usize, w: usize) -> Vec<f32> {
     let clamp = |i: isize, n: usize| i.clamp(0, n as isize - 1) as usize;
     let mut tmp = vec![0.0; h * w];
     for y in 0..h {

@@ -6,7 +6,10 @@
 
 mod laplacian;
 
-pub use laplacian::{laplacian_denoise, laplacian_merge, laplacian_split, lowpass, upsample_low, LAPLACIAN_FACTOR};
+pub use laplacian::{
+    blur, box_downsample, laplacian_denoise, laplacian_merge, laplacian_split, lowpass, upsample_low, BLUR_RADIUS,
+    LAPLACIAN_FACTOR,
+};
 
 /// Signed square root, `sign(e)·√|e|`: compresses the huge range of elevations (metres)
 /// so that valleys and the deep sea get a fair share of the model's precision.

@@ -14,7 +14,7 @@ use burn::tensor::{Device, Tensor, TensorData};
 
 use super::store::{LoadedModel, Normalisation};
 use super::{Sampler, UNet};
-use crate::encoding::{signed_sqrt, signed_square, LAPLACIAN_FACTOR};
+use crate::encoding::{blur, signed_sqrt, signed_square, BLUR_RADIUS, LAPLACIAN_FACTOR};
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::noise::{GaussianNoise, NoiseKey};
 use crate::tile::{Rect, Tile};
@@ -32,7 +32,8 @@ pub fn noise_stream(stage: &str) -> u32 {
 }
 
 /// A learned stage's model as a [`WindowFn`]: elevation in metres (one channel) on its grid,
-/// generated as the residual over a context 8× coarser.
+/// generated as the residual over a context 8× coarser (the context source gives plain box
+/// means or point values; the stage blurs them as training's Laplacian low band is blurred).
 pub struct LearnedStage {
     name: String,
     net: UNet,
@@ -67,12 +68,23 @@ impl LearnedStage {
     }
 
     /// The conditioning of one window, in the network's units, and the un-normalised
-    /// signed-sqrt low band the output is added to.
-    fn context(&self, rect: Rect) -> (Vec<f32>, Vec<f32>) {
+    /// signed-sqrt low band the output is added to. Built exactly like training's low band:
+    /// the coarse grid (box means) in signed sqrt, blurred, bilinearly upsampled — the blur
+    /// reads [`BLUR_RADIUS`] extra cells on each side, so neighbouring windows agree.
+    pub(crate) fn context(&self, rect: Rect) -> (Vec<f32>, Vec<f32>) {
         let f = LAPLACIAN_FACTOR as i64;
-        let coarse = self.coarse.query(upsample::source_rect(&rect, f));
-        let coarse = Tile::from_data(1, coarse.rect, coarse.data.iter().map(|&e| signed_sqrt(e)).collect());
-        let low = upsample::bilinear(&coarse, f, rect).data;
+        let src = upsample::source_rect(&rect, f);
+        let r = BLUR_RADIUS as i64;
+        let padded = Rect::new(src.y0 - r, src.x0 - r, src.h + 2 * r, src.w + 2 * r);
+        let h: Vec<f32> = self.coarse.query(padded).data.iter().map(|&e| signed_sqrt(e)).collect();
+        let blurred = blur(&h, padded.h as usize, padded.w as usize);
+        let inner = (0..src.h)
+            .flat_map(|y| {
+                let row = ((y + r) * padded.w + r) as usize;
+                blurred[row..row + src.w as usize].iter().copied()
+            })
+            .collect();
+        let low = upsample::bilinear(&Tile::from_data(1, src, inner), f, rect).data;
         let cond = low.iter().map(|&v| (v - self.norm.cond_mean) / self.norm.cond_scale).collect();
         (cond, low)
     }

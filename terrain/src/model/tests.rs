@@ -286,6 +286,62 @@ fn tiny_core(batch: usize) -> LearnedStage {
     LearnedStage::new(LoadedModel { net, manifest }, device(), Arc::new(Hills), 42, batch)
 }
 
+/// A fine field (metres) and its coarse grid as the pipeline provides it: box means over
+/// 8×8 fine cells, in signed sqrt (as training averages), returned in metres.
+fn fine_metres(y: i64, x: i64) -> f32 {
+    let (y, x) = (y as f32, x as f32);
+    900.0 * (y * 0.021).sin() * (x * 0.017).cos() + 120.0 * (x * 0.31 + y * 0.13).sin() + 200.0
+}
+
+struct BoxMeans;
+
+impl Source for BoxMeans {
+    fn channels(&self) -> usize {
+        1
+    }
+
+    fn query(&self, rect: Rect) -> Tile {
+        let data = (rect.y0..rect.y1())
+            .flat_map(|cy| (rect.x0..rect.x1()).map(move |cx| (cy, cx)))
+            .map(|(cy, cx)| {
+                let mut sum = 0.0;
+                for y in cy * 8..cy * 8 + 8 {
+                    for x in cx * 8..cx * 8 + 8 {
+                        sum += crate::encoding::signed_sqrt(fine_metres(y, x));
+                    }
+                }
+                crate::encoding::signed_square(sum / 64.0)
+            })
+            .collect();
+        Tile::from_data(1, rect, data)
+    }
+}
+
+#[test]
+fn a_window_s_context_is_the_low_band_training_computes() {
+    use crate::encoding::{lowpass, signed_sqrt, upsample_low};
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    let stage = LearnedStage::new(LoadedModel { net, manifest }, device(), Arc::new(BoxMeans), 1, 1);
+    // Training: a 160² tile (origin on the 8-cell grid) encoded whole; the window sits in its
+    // interior, away from the tile's clamped edges.
+    let (t0, n) = ((-64i64, 40i64), 160usize);
+    let h: Vec<f32> =
+        (0..n as i64).flat_map(|y| (0..n as i64).map(move |x| signed_sqrt(fine_metres(t0.0 + y, t0.1 + x)))).collect();
+    let low = upsample_low(&lowpass(&h, n, n), n, n);
+    let window = Rect::new(t0.0 + 64, t0.1 + 48, 32, 32);
+    let (_, got) = stage.context(window);
+    let mut worst = 0.0f32;
+    for y in 0..32 {
+        for x in 0..32 {
+            let want = low[(64 + y) * n + 48 + x];
+            worst = worst.max((got[y * 32 + x] - want).abs());
+        }
+    }
+    assert!(worst < 1e-3, "context differs from training's low band by {worst} (signed-sqrt metres)");
+}
+
 #[test]
 fn the_core_stage_is_seed_consistent_through_the_engine() {
     let region = Rect::new(-40, 25, 48, 40);
