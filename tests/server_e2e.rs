@@ -52,6 +52,8 @@ struct Server {
     stdin: Option<ChildStdin>,
     lines: Receiver<String>,
     stderr: Arc<Mutex<Vec<String>>>,
+    /// Every stdout line read so far (matched or passed over by [`Server::expect_line`]).
+    history: Vec<String>,
     port: u16,
     config: Config,
     _dir: tempfile::TempDir,
@@ -107,7 +109,7 @@ impl Server {
             }
         });
         let stdin = child.stdin.take();
-        let mut server = Server { child, stdin, lines, stderr, port, config, _dir: dir };
+        let mut server = Server { child, stdin, lines, stderr, history: Vec::new(), port, config, _dir: dir };
         server.expect_line(|l| l.contains("listening on"), START_TIMEOUT);
         server
     }
@@ -119,12 +121,23 @@ impl Server {
         loop {
             let left = deadline.saturating_duration_since(Instant::now());
             match self.lines.recv_timeout(left) {
-                Ok(line) if want(&line) => return line,
-                Ok(line) => seen.push(line),
+                Ok(line) if want(&line) => {
+                    self.history.push(line.clone());
+                    return line;
+                }
+                Ok(line) => {
+                    self.history.push(line.clone());
+                    seen.push(line)
+                }
                 Err(RecvTimeoutError::Timeout) => self.fail(&format!("timed out; stdout so far: {seen:#?}")),
                 Err(RecvTimeoutError::Disconnected) => self.fail(&format!("server exited; stdout: {seen:#?}")),
             }
         }
+    }
+
+    /// Whether a stdout line read so far matches `want`.
+    fn stdout_seen(&self, want: impl Fn(&str) -> bool) -> bool {
+        self.history.iter().any(|l| want(l))
     }
 
     /// Types a console command.
@@ -277,6 +290,10 @@ fn the_shipped_learned_core_stage_serves_the_terrain_this_process_computes() {
     );
     let mut server = Server::start_with(&biomes, 7, dir, &world);
     let rules = load_rules(&biomes);
+    assert!(
+        server.stdout_seen(|l| l.starts_with("terrain: learned stages core from")),
+        "the start-up log says the learned core runs"
+    );
     // Built here with one engine thread (the server runs two): the same bits whatever the
     // thread count.
     let mut terrain = server.config.terrain();
@@ -300,6 +317,10 @@ fn the_shipped_learned_core_stage_serves_the_terrain_this_process_computes() {
 fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
     let biomes = repo().join("biomes");
     let mut server = Server::start(&biomes, 1);
+    assert!(
+        server.stdout_seen(|l| l.starts_with("terrain: procedural layout only")),
+        "no [engine] learned: procedural"
+    );
     let rules = load_rules(&biomes);
     let generator = generator(&server.config);
     let v = *generator.vertical();

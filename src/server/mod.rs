@@ -76,6 +76,19 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
 
     let pipeline =
         Pipeline::build(config.world.seed, &config.terrain()).map_err(|e| ServeError::Input(anyhow::anyhow!("{e}")))?;
+    // Owners should see at once whether the learned stages run (and from which folder).
+    let learned: Vec<String> =
+        pipeline.active_stages().into_iter().filter(|s| s != "layout" && s != "climate").collect();
+    if learned.is_empty() {
+        say!("terrain: procedural layout only (engine.learned = [])");
+    } else {
+        say!(
+            "terrain: learned stages {} from {} on {}",
+            learned.join(", "),
+            config.engine.models.display(),
+            config.engine.backend
+        );
+    }
     let pipeline = Arc::new(pipeline);
     let generator = Arc::new(Generator::new(pipeline, config));
     say!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
