@@ -49,7 +49,7 @@ impl Source for ClampedGrid {
 fn counterpart(model: &LoadedModel, device: &Device, h: &[f32], n: usize, seed: u64) -> (Vec<f32>, u64) {
     // The stage blurs its context itself, so it is given the box means (the clamped extension
     // then blurs exactly as training's lowpass does at tile edges).
-    let means = box_downsample(h, n, n);
+    let means = box_downsample(h, n, n, LAPLACIAN_FACTOR);
     let coarse =
         ClampedGrid { size: (n / LAPLACIAN_FACTOR) as i64, metres: means.iter().map(|&v| signed_square(v)).collect() };
     let engine = Engine::new(EngineConfig { cache_bytes: 256 << 20, threads: 2 });

@@ -21,11 +21,11 @@ fn downsample(x: &[f32], h: usize, w: usize, f: usize) -> Vec<f32> {
     out
 }
 
-/// The box-downsampled (by [`LAPLACIAN_FACTOR`]) grid of an `h × w` image, before the blur
-/// [`lowpass`] applies: what a learned stage's context source provides.
-pub fn box_downsample(x: &[f32], h: usize, w: usize) -> Vec<f32> {
-    assert!(h % LAPLACIAN_FACTOR == 0 && w % LAPLACIAN_FACTOR == 0, "{h}×{w} is not a multiple of {LAPLACIAN_FACTOR}");
-    downsample(x, h, w, LAPLACIAN_FACTOR)
+/// The `h × w` image box-downsampled by `f` (cell means); with [`LAPLACIAN_FACTOR`] it is
+/// the grid [`lowpass`] blurs — what a learned stage's context source provides.
+pub fn box_downsample(x: &[f32], h: usize, w: usize, f: usize) -> Vec<f32> {
+    assert!(f > 0 && h % f == 0 && w % f == 0, "{h}×{w} is not a multiple of {f}");
+    downsample(x, h, w, f)
 }
 
 /// Half-width of [`blur`] in cells: a context needs this many extra cells on every side.

@@ -12,7 +12,7 @@ use std::sync::Arc;
 pub use stages::{StageState, StageStatus};
 
 use crate::climate::{precipitation, temperature_at, Orographic};
-use crate::encoding::LAPLACIAN_FACTOR;
+use crate::encoding::{box_downsample, LAPLACIAN_FACTOR};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::settings::TerrainSettings;
@@ -81,8 +81,8 @@ pub enum PipelineError {
 }
 
 /// A grid `factor`× coarser than its source's, each cell the mean of its `factor`² source
-/// cells (the context a learned stage is conditioned on, like the Laplacian low band it was
-/// trained with).
+/// cells: the context a learned stage is conditioned on (with [`LAPLACIAN_FACTOR`], the box
+/// downsample of training's Laplacian low band; the stage applies the blur).
 #[cfg_attr(not(feature = "learned"), allow(dead_code))]
 struct BoxMean {
     source: Arc<dyn Source>,
@@ -97,23 +97,9 @@ impl Source for BoxMean {
     fn query(&self, rect: Rect) -> Tile {
         let f = self.factor;
         let fine = self.source.query(Rect::new(rect.y0 * f, rect.x0 * f, rect.h * f, rect.w * f));
-        let c = fine.channels;
-        let mut out = Tile::zeros(c, rect);
-        let (fw, n, fine_n) = ((rect.w * f) as usize, rect.area(), fine.rect.area());
-        let scale = 1.0 / (f * f) as f32;
-        for ch in 0..c {
-            for y in 0..rect.h as usize {
-                for x in 0..rect.w as usize {
-                    let mut sum = 0.0f32;
-                    for dy in 0..f as usize {
-                        let row = (y * f as usize + dy) * fw + x * f as usize;
-                        sum += fine.data[ch * fine_n + row..ch * fine_n + row + f as usize].iter().sum::<f32>();
-                    }
-                    out.data[ch * n + y * rect.w as usize + x] = sum * scale;
-                }
-            }
-        }
-        out
+        let (h, w) = (fine.rect.h as usize, fine.rect.w as usize);
+        let data = (0..fine.channels).flat_map(|c| box_downsample(fine.channel(c), h, w, f as usize)).collect();
+        Tile::from_data(fine.channels, rect, data)
     }
 }
 
@@ -218,6 +204,16 @@ impl Pipeline {
         &self.stages
     }
 
+    /// Names of the learned stages that run (a subset of
+    /// [`LEARNED_STAGES`](crate::settings::LEARNED_STAGES)); empty for the procedural layout.
+    pub fn learned_stages(&self) -> Vec<&'static str> {
+        self.stages
+            .iter()
+            .filter(|s| s.state == StageState::Active && crate::settings::LEARNED_STAGES.contains(&s.name))
+            .map(|s| s.name)
+            .collect()
+    }
+
     /// Names of the stages that ran to produce answers (for file metadata and logs).
     pub fn active_stages(&self) -> Vec<String> {
         self.stages.iter().filter(|s| s.state == StageState::Active).map(|s| s.name.to_string()).collect()
@@ -279,11 +275,7 @@ impl Pipeline {
     /// per region file). A no-op without learned stages: then windows are cheap and the
     /// procedural layout is computed per query anyway.
     pub fn prefetch(&self, blocks: Rect) {
-        let learned = self
-            .stages
-            .iter()
-            .any(|s| s.state == StageState::Active && crate::settings::LEARNED_STAGES.contains(&s.name));
-        if learned {
+        if !self.learned_stages().is_empty() {
             self.model(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
         }
     }
