@@ -77,8 +77,7 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
     let pipeline =
         Pipeline::build(config.world.seed, &config.terrain()).map_err(|e| ServeError::Input(anyhow::anyhow!("{e}")))?;
     // Owners should see at once whether the learned stages run (and from which folder).
-    let learned: Vec<String> =
-        pipeline.active_stages().into_iter().filter(|s| s != "layout" && s != "climate").collect();
+    let learned = pipeline.learned_stages();
     if learned.is_empty() {
         say!("terrain: procedural layout only (engine.learned = [])");
     } else {
