@@ -9,7 +9,8 @@
 use std::path::{Path, PathBuf};
 
 use infiniterra_terrain::encoding::{lowpass, signed_sqrt, upsample_low, LAPLACIAN_FACTOR};
-use infiniterra_terrain::model::{sha256_file, DataChecksum, HostRng, NoiseDistribution, Normalisation};
+use infiniterra_terrain::model::hint::{features, FEATURES};
+use infiniterra_terrain::model::{sha256_file, DataChecksum, HostRng, NoiseDistribution, Normalisation, ReliefHint};
 
 use crate::export::read_npy_f32;
 
@@ -22,6 +23,9 @@ const VECTOR_DROPOUT: f64 = 0.2;
 const STREAM_BATCH: u64 = 0x6261_7463;
 const STREAM_STATS: u64 = 0x7374_6174;
 const STREAM_PREVIEW: u64 = 0x7072_6576;
+const STREAM_HINT: u64 = 0x6869_6e74;
+/// Crops the relief hint is fitted on.
+const HINT_CROPS: usize = 4000;
 
 /// One tile, encoded: signed-sqrt elevation and its upsampled low band, both `size²`.
 #[derive(Clone, Debug)]
@@ -144,6 +148,21 @@ impl TileSet {
             relief_mean: lm as f32,
             relief_std: ls as f32,
         }
+    }
+
+    /// The relief hint of this set: `relief_z` (as the conditioning vector holds it) regressed
+    /// on the context statistics of [`HINT_CROPS`] fixed crops. Deterministic.
+    pub fn relief_hint(&self, crop: usize, norm: &Normalisation) -> Option<ReliefHint> {
+        let mut rng = HostRng::keyed(0, STREAM_HINT, 0, 0);
+        let (mut x, mut z): (Vec<[f64; FEATURES]>, Vec<f64>) = (Vec::new(), Vec::new());
+        for _ in 0..HINT_CROPS {
+            let (t, y0, x0, _) = self.pick(&mut rng, crop);
+            let residual = crop_of(t, y0, x0, crop, 0, |t, k| t.h[k] - t.low[k]);
+            let low = crop_of(t, y0, x0, crop, 0, |t, k| t.low[k]);
+            x.push(features(&low, crop));
+            z.push((log_std(&residual) - norm.relief_mean as f64) / norm.relief_std as f64);
+        }
+        ReliefHint::fit(&x, &z)
     }
 
     /// The smallest tile side (crops must fit every tile).
@@ -273,6 +292,32 @@ pub fn synthetic(count: usize, size: usize) -> TileSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_relief_hint_learns_that_rough_context_means_rough_detail() {
+        // Tiles whose small-scale roughness grows with their large-scale relief, as on Earth.
+        let size = 128;
+        let tiles: Vec<EncodedTile> = (1..=6)
+            .map(|k| {
+                let a = 60.0 * k as f32;
+                let metres: Vec<f32> = (0..size * size)
+                    .map(|i| {
+                        let (y, x) = ((i / size) as f32, (i % size) as f32);
+                        a * 4.0 * (x * 0.04 + k as f32).sin() * (y * 0.03).cos() + a * (x * 0.9 + y * 0.4).sin() + 500.0
+                    })
+                    .collect();
+                EncodedTile::from_metres(size, &metres)
+            })
+            .collect();
+        let set = TileSet { tiles, checksums: Vec::new() };
+        let norm = set.normalisation(32, 0.5);
+        let hint = set.relief_hint(32, &norm).expect("well-posed");
+        assert_eq!(set.relief_hint(32, &norm), Some(hint.clone()), "the fit is deterministic");
+        assert!(hint.r2 > 0.8, "R² {}", hint.r2);
+        let low = |t: &EncodedTile| crop_of(t, 10, 20, 32, 0, |t, k| t.low[k]);
+        let (gentle, rough) = (hint.predict(&low(&set.tiles[0]), 32), hint.predict(&low(&set.tiles[5]), 32));
+        assert!(rough > gentle + 1.0, "rough context → {rough}, gentle → {gentle}");
+    }
 
     #[test]
     fn batches_are_a_function_of_seed_and_step() {

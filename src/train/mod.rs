@@ -99,6 +99,10 @@ pub struct TrainArgs {
     /// Picture written by `--counterpart`.
     #[arg(long, default_value = "docs/core_vs_real.png")]
     pub picture: PathBuf,
+    /// Instead of training: fit the relief hint (context → expected roughness) of the shipped
+    /// `<out>/<stage>.json` on the stage's training data and write it into that manifest.
+    #[arg(long)]
+    pub fit_relief_hint: bool,
     /// Use a very small network and no data files (smoke tests of the training machinery).
     #[arg(long, hide = true)]
     pub smoke: bool,
@@ -151,6 +155,37 @@ fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, Failure> {
 /// training on them would leak held-out terrain into the model.
 fn stage_data(stage: &str, dir: &Path) -> Result<(TileSet, TileSet), String> {
     Ok((read_split(&dir.join(stage), "train", 1)?, read_split(&dir.join(stage), "heldout", 1)?))
+}
+
+/// Fits the relief hint of the shipped `<models>/<stage>.json` on the stage's training data
+/// (the crops and normalisation it was trained with) and writes it into the manifest; the
+/// weights are untouched. Training does the same when it ships.
+fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()> {
+    let path = models.join(format!("{stage}.json"));
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let manifest: ModelManifest =
+        serde_json::from_str(&text).with_context(|| format!("{} is not a model manifest", path.display()))?;
+    let (train, _) = stage_data(stage, data).map_err(|e| anyhow!(e))?;
+    let hint = train
+        .relief_hint(manifest.training.crop, &manifest.normalisation)
+        .ok_or_else(|| anyhow!("{}: the relief-hint fit is singular on this data", data.display()))?;
+    println!(
+        "relief hint of {}: coefficients {:?} on {:?}, R² {:.3}",
+        path.display(),
+        hint.coefficients,
+        hint.features,
+        hint.r2
+    );
+    // Only the new key changes: the rest of the file is kept as written (floats included).
+    let mut value: serde_json::Value = serde_json::from_str(&text)?;
+    if let Some(object) = value.as_object_mut() {
+        object.insert("relief_hint".into(), serde_json::to_value(&hint)?);
+    }
+    let tmp = path.with_extension("json.tmp");
+    std::fs::write(&tmp, serde_json::to_string_pretty(&value)? + "\n")
+        .and_then(|()| std::fs::rename(&tmp, &path))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
 }
 
 /// What a checkpoint records besides tensors.
@@ -211,6 +246,9 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
         let seed = seed.unwrap_or(DEFAULT_SEED);
         return heldout::generate(&args.out, &args.stage, &args.data, out, args.tiles, seed, args.backend)
             .map_err(Failure::runtime);
+    }
+    if args.fit_relief_hint {
+        return fit_relief_hint(&args.out, &args.stage, &args.data).map_err(Failure::runtime);
     }
     if args.crop == 0 || args.crop % spec.config.size_multiple().max(8) != 0 {
         return Err(Failure::input(anyhow!("--crop must be a positive multiple of 8, got {}", args.crop)));
@@ -501,6 +539,7 @@ impl Trainer {
         manifest.metres_per_pixel = self.spec_metres;
         manifest.window = 64;
         manifest.normalisation = self.state.normalisation.clone();
+        manifest.relief_hint = self.train.relief_hint(self.state.crop, &self.state.normalisation);
         manifest.training = TrainingRecord {
             steps: self.state.step,
             batch: self.state.batch,

@@ -23,6 +23,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         tiles: 0,
         generate_heldout: None,
         counterpart: None,
+        fit_relief_hint: false,
         picture: PathBuf::from("unused.png"),
         smoke: true,
     }
@@ -62,6 +63,7 @@ fn training_is_deterministic_and_resumes_exactly() {
         serde_json::from_str(&std::fs::read_to_string(resumed.join("core.json")).expect("manifest")).expect("parses");
     assert_eq!(manifest.training.steps, 4);
     assert!(manifest.parameters > 0 && !manifest.weights_sha256.is_empty());
+    assert!(manifest.relief_hint.is_some(), "shipping fits the relief hint");
     assert!(resumed.join("checkpoints/core/samples_000004.png").exists());
     let _ = std::fs::remove_dir_all(&straight);
     let _ = std::fs::remove_dir_all(&resumed);

@@ -11,6 +11,7 @@
 //! as a [`WindowFn`](crate::infinite::WindowFn)), the pipeline's stage choice, Minecraft.
 
 mod edm;
+pub mod hint;
 mod layers;
 mod rng;
 mod sampler;
@@ -28,6 +29,7 @@ use burn::tensor::Device;
 pub use burn;
 
 pub use edm::{edm_loss, NoiseDistribution};
+pub use hint::ReliefHint;
 pub use layers::{force_normalize, mp_cat, mp_silu, mp_sum, normalize_rows, pixel_norm, MpConv, MpLinear};
 pub use rng::HostRng;
 pub use sampler::{Sampler, SamplerKind};

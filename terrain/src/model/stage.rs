@@ -13,7 +13,7 @@ use std::sync::Arc;
 use burn::tensor::{Device, Tensor, TensorData};
 
 use super::store::{LoadedModel, Normalisation};
-use super::{Sampler, UNet};
+use super::{ReliefHint, Sampler, UNet};
 use crate::encoding::{blur, signed_sqrt, signed_square, BLUR_RADIUS, LAPLACIAN_FACTOR};
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::noise::{GaussianNoise, NoiseKey};
@@ -40,6 +40,7 @@ pub struct LearnedStage {
     device: Device,
     sampler: Sampler,
     norm: Normalisation,
+    hint: Option<ReliefHint>,
     coarse: Arc<dyn Source>,
     seed: u64,
     window: i64,
@@ -57,6 +58,7 @@ impl LearnedStage {
             name: model.manifest.stage.clone(),
             sampler: model.manifest.sampler.clone(),
             norm: model.manifest.normalisation.clone(),
+            hint: model.manifest.relief_hint.clone(),
             net: model.net,
             device,
             coarse,
@@ -87,6 +89,28 @@ impl LearnedStage {
         let low = upsample::bilinear(&Tile::from_data(1, src, inner), f, rect).data;
         let cond = low.iter().map(|&v| (v - self.norm.cond_mean) / self.norm.cond_scale).collect();
         (cond, low)
+    }
+}
+
+impl LearnedStage {
+    /// The conditioning vectors of windows whose low bands are `lows`, row-major
+    /// `[windows, vector_dim]`: `[relief_z, 1]` predicted from each context when the manifest
+    /// has a relief hint, otherwise zeros ("no hint": the network was trained with the vector
+    /// dropped for a fifth of its samples). `None` for a network without a vector input.
+    pub(crate) fn conditioning_vector(&self, lows: &[Vec<f32>]) -> Option<Vec<f32>> {
+        let dim = self.net.config.vector_dim;
+        if dim == 0 {
+            return None;
+        }
+        let side = self.window as usize;
+        let mut v = vec![0.0f32; lows.len() * dim];
+        if let Some(hint) = &self.hint {
+            for (row, low) in v.chunks_mut(dim).zip(lows) {
+                row[0] = hint.predict(low, side);
+                row[1] = 1.0;
+            }
+        }
+        Some(v)
     }
 }
 
@@ -133,9 +157,9 @@ impl WindowFn for LearnedStage {
             })
             .collect();
         let cond = Tensor::<4>::from_data(TensorData::new(cond, [b, 1, side, side]), &self.device);
-        // Zeros: "no relief hint" (the network was trained with the vector dropped out).
-        let vector =
-            (self.net.config.vector_dim > 0).then(|| Tensor::<2>::zeros([b, self.net.config.vector_dim], &self.device));
+        let vector = self
+            .conditioning_vector(&lows)
+            .map(|v| Tensor::<2>::from_data(TensorData::new(v, [b, self.net.config.vector_dim]), &self.device));
         let out = self.sampler.sample(&self.net, &noises, Some(cond), vector);
         let values: Vec<f32> = out.into_data().try_into_vec().expect("the network outputs f32");
         rects

@@ -15,6 +15,7 @@ use burn::tensor::{DType, Device};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::hint::ReliefHint;
 use super::sampler::Sampler;
 use super::unet::{UNet, UNetConfig};
 
@@ -104,6 +105,10 @@ pub struct ModelManifest {
     pub window: usize,
     /// Value mapping.
     pub normalisation: Normalisation,
+    /// Predicts the relief entry of the conditioning vector from the context; without it the
+    /// stage runs with the vector dropped (zeros), as older manifests did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relief_hint: Option<ReliefHint>,
     /// The sampler to run it with.
     pub sampler: Sampler,
     /// How it was trained.
@@ -133,6 +138,7 @@ impl ModelManifest {
             metres_per_pixel: 0.0,
             window: 64,
             normalisation: Normalisation::default(),
+            relief_hint: None,
             sampler,
             training: TrainingRecord::default(),
             data: Vec::new(),
@@ -289,6 +295,9 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
         if !(v.is_finite() && v > 0.0) {
             return Err(manifest_corrupt(format!("normalisation.{name} = {v} (must be a positive number)")));
         }
+    }
+    if let Some(hint) = &manifest.relief_hint {
+        hint.validate().map_err(manifest_corrupt)?;
     }
     if !(manifest.metres_per_pixel.is_finite() && manifest.metres_per_pixel > 0.0) {
         return Err(manifest_corrupt(format!("metres_per_pixel = {} (must be positive)", manifest.metres_per_pixel)));

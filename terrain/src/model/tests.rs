@@ -343,6 +343,53 @@ fn a_window_s_context_is_the_low_band_training_computes() {
 }
 
 #[test]
+fn the_relief_hint_steers_each_window_from_its_own_context() {
+    use crate::model::hint::FEATURE_NAMES;
+    let plain = tiny_core(2);
+    let region = Rect::new(-40, 25, 48, 40);
+    let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 });
+    let without = Windowed::new(&engine, tiny_core(2)).query(region);
+
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    manifest.normalisation =
+        Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+    manifest.relief_hint = Some(ReliefHint {
+        features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
+        coefficients: vec![0.5, 0.1, 0.8, 0.3],
+        r2: 0.9,
+    });
+    let hinted = LearnedStage::new(LoadedModel { net, manifest: manifest.clone() }, device(), Arc::new(Hills), 42, 2);
+    // Each window's vector is the hint's prediction from that window's own low band.
+    let windows = [Rect::new(0, 0, 32, 32), Rect::new(-80, 48, 32, 32)];
+    let lows: Vec<Vec<f32>> = windows.iter().map(|&r| hinted.context(r).1).collect();
+    let v = hinted.conditioning_vector(&lows).expect("the tiny net takes a vector");
+    let hint = manifest.relief_hint.as_ref().expect("set above");
+    for (row, low) in v.chunks(2).zip(&lows) {
+        assert_eq!(row, [hint.predict(low, 32), 1.0]);
+    }
+    assert_ne!(v[0], v[2], "two different contexts gave the same relief hint");
+    assert_eq!(plain.conditioning_vector(&lows), Some(vec![0.0; 4]), "no hint: the dropped (zero) vector");
+    // And it reaches the network: the terrain differs, still finite and seed-consistent.
+    let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 1 });
+    let with = Windowed::new(&engine, hinted).query(region);
+    assert!(with.data.iter().all(|x| x.is_finite()));
+    assert_ne!(with, without);
+
+    // A manifest whose hint this build cannot compute is refused, naming the entry.
+    let dir = tempdir("hint");
+    let net = perturbed_tiny(11);
+    save_model(&dir, &net, manifest, Precision::F32).expect("save");
+    let path = dir.join("test.json");
+    let text = std::fs::read_to_string(&path).expect("read").replace("ln_std_low", "ln_std_of_something_else");
+    std::fs::write(&path, text).expect("write");
+    let msg = load_model(&dir, "test", &device()).expect_err("foreign hint").to_string();
+    assert!(msg.contains("test.json") && msg.contains("relief_hint.features"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn the_core_stage_is_seed_consistent_through_the_engine() {
     let region = Rect::new(-40, 25, 48, 40);
     let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 });

@@ -1,0 +1,149 @@
+//! The relief hint: a window's expected roughness, predicted from its context alone.
+//!
+//! The networks are trained with a conditioning vector `[relief_z, present]`, where `relief_z`
+//! is the z-scored ln standard deviation of the crop's own residual (the relief the model is
+//! asked to draw); it is dropped (all zeros) for a fifth of the samples so the model also
+//! works without it. Unconditioned, a model trained on gentler land than it is asked to
+//! draw regresses towards the average roughness of its training set, so great ranges come
+//! out too smooth. The hint closes that gap without peeking at the answer: a linear model of
+//! `relief_z` on statistics of the window's low band — the only thing the pipeline knows
+//! there — fitted by least squares on the training crops.
+
+use serde::{Deserialize, Serialize};
+
+/// Number of context features (a constant included).
+pub const FEATURES: usize = 4;
+/// Names of the features, in coefficient order, for the manifest and logs.
+pub const FEATURE_NAMES: [&str; FEATURES] = ["1", "mean_low", "ln_std_low", "ln_mean_gradient_low"];
+
+/// A linear predictor of the relief entry of the conditioning vector.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ReliefHint {
+    /// What each coefficient multiplies ([`FEATURE_NAMES`]).
+    pub features: Vec<String>,
+    /// One coefficient per feature.
+    pub coefficients: Vec<f64>,
+    /// Fraction of the variance of `relief_z` the fit explains on its training crops.
+    pub r2: f64,
+}
+
+/// The context statistics of one square window of side `side`: its low band in signed-sqrt
+/// units (√m), as the model's conditioning channel holds it before normalisation.
+pub fn features(low: &[f32], side: usize) -> [f64; FEATURES] {
+    assert_eq!(low.len(), side * side);
+    let n = low.len() as f64;
+    let mean = low.iter().map(|&v| v as f64).sum::<f64>() / n;
+    let var = low.iter().map(|&v| (v as f64 - mean).powi(2)).sum::<f64>() / n;
+    let mut gradient = 0.0f64;
+    for y in 0..side - 1 {
+        for x in 0..side - 1 {
+            let v = low[y * side + x];
+            gradient += ((low[y * side + x + 1] - v).abs() + (low[(y + 1) * side + x] - v).abs()) as f64;
+        }
+    }
+    let gradient = gradient / ((side - 1) * (side - 1)) as f64;
+    [1.0, mean / 100.0, (var.sqrt() + 1e-2).ln(), (gradient + 1e-3).ln()]
+}
+
+impl ReliefHint {
+    /// Least-squares fit of `targets` on the feature rows `x`. `None` when the system is
+    /// singular (too few or degenerate samples).
+    pub fn fit(x: &[[f64; FEATURES]], targets: &[f64]) -> Option<ReliefHint> {
+        assert_eq!(x.len(), targets.len());
+        // Normal equations XᵀX·c = Xᵀy, solved by Gaussian elimination with partial pivoting
+        // (4×4: no library needed).
+        let mut a = [[0.0f64; FEATURES + 1]; FEATURES];
+        for (row, &t) in x.iter().zip(targets) {
+            for i in 0..FEATURES {
+                for j in 0..FEATURES {
+                    a[i][j] += row[i] * row[j];
+                }
+                a[i][FEATURES] += row[i] * t;
+            }
+        }
+        for col in 0..FEATURES {
+            let pivot = (col..FEATURES).max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs()))?;
+            if a[pivot][col].abs() < 1e-9 {
+                return None;
+            }
+            a.swap(col, pivot);
+            for r in 0..FEATURES {
+                if r != col {
+                    let f = a[r][col] / a[col][col];
+                    for c in col..=FEATURES {
+                        a[r][c] -= f * a[col][c];
+                    }
+                }
+            }
+        }
+        let coefficients: Vec<f64> = (0..FEATURES).map(|i| a[i][FEATURES] / a[i][i]).collect();
+        let mean = targets.iter().sum::<f64>() / targets.len() as f64;
+        let total: f64 = targets.iter().map(|t| (t - mean).powi(2)).sum();
+        let residual: f64 = x
+            .iter()
+            .zip(targets)
+            .map(|(row, t)| (t - row.iter().zip(&coefficients).map(|(f, c)| f * c).sum::<f64>()).powi(2))
+            .sum();
+        Some(ReliefHint {
+            features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
+            coefficients,
+            r2: if total > 0.0 { 1.0 - residual / total } else { 0.0 },
+        })
+    }
+
+    /// The predicted `relief_z` of a window whose low band is `low` (side `side`).
+    pub fn predict(&self, low: &[f32], side: usize) -> f32 {
+        features(low, side).iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>() as f32
+    }
+
+    /// Checks the manifest entry has the shape this code computes.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.features != FEATURE_NAMES {
+            return Err(format!("relief_hint.features = {:?}, this build computes {:?}", self.features, FEATURE_NAMES));
+        }
+        if self.coefficients.len() != FEATURES || self.coefficients.iter().any(|c| !c.is_finite()) {
+            return Err(format!("relief_hint.coefficients must be {FEATURES} finite numbers"));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fit_recovers_a_linear_relation_and_predict_applies_it() {
+        // Windows of rising roughness: sine ridges of growing amplitude on a sloping base.
+        let side = 16;
+        let windows: Vec<Vec<f32>> = (1..40)
+            .map(|k| {
+                (0..side * side)
+                    .map(|i| {
+                        let (y, x) = ((i / side) as f32, (i % side) as f32);
+                        10.0 + k as f32 + (k as f32 * 0.3) * (x * 0.7).sin() + 0.05 * y * (k % 3) as f32
+                    })
+                    .collect()
+            })
+            .collect();
+        let x: Vec<[f64; FEATURES]> = windows.iter().map(|w| features(w, side)).collect();
+        let truth = [0.5, -2.0, 1.5, 0.25];
+        let y: Vec<f64> = x.iter().map(|f| f.iter().zip(&truth).map(|(a, b)| a * b).sum()).collect();
+        let hint = ReliefHint::fit(&x, &y).expect("well-posed");
+        for (c, t) in hint.coefficients.iter().zip(truth) {
+            assert!((c - t).abs() < 1e-6, "{:?} vs {truth:?}", hint.coefficients);
+        }
+        assert!(hint.r2 > 0.999_999);
+        assert!((hint.predict(&windows[7], side) as f64 - y[7]).abs() < 1e-4);
+        hint.validate().expect("fresh fit is valid");
+    }
+
+    #[test]
+    fn a_degenerate_sample_set_is_refused_and_a_foreign_manifest_entry_is_named() {
+        let flat = vec![3.0f32; 64];
+        let x = vec![features(&flat, 8); 10];
+        assert_eq!(ReliefHint::fit(&x, &[1.0; 10]), None);
+        let bad = ReliefHint { features: vec!["1".into()], coefficients: vec![0.0], r2: 0.0 };
+        assert!(bad.validate().unwrap_err().contains("relief_hint.features"));
+    }
+}
