@@ -105,7 +105,10 @@ impl Windowed {
             keys: windows.iter().map(|&i| self.key(i)).collect(),
             published: windows.iter().map(|_| Default::default()).collect(),
         };
-        let batch = self.f.batch_size().max(1);
+        // Batches of at most Φ's preferred size, but never fewer batches than worker threads
+        // when there are enough windows: two windows claimed by one query run on two threads
+        // rather than as one batch on one (what a player walking into fresh ground triggers).
+        let batch = self.f.batch_size().max(1).min(windows.len().div_ceil(self.engine.threads())).max(1);
         let batches: Vec<(usize, &[WindowIndex])> =
             windows.chunks(batch).enumerate().map(|(b, w)| (b * batch, w)).collect();
         let per_batch = self.engine.par_map(&batches, |&(first, ws)| {
