@@ -90,9 +90,7 @@ impl LearnedStage {
         let cond = low.iter().map(|&v| (v - self.norm.cond_mean) / self.norm.cond_scale).collect();
         (cond, low)
     }
-}
 
-impl LearnedStage {
     /// The conditioning vectors of windows whose low bands are `lows`, row-major
     /// `[windows, vector_dim]`: `[relief_z, 1]` predicted from each context when the manifest
     /// has a relief hint, otherwise zeros ("no hint": the network was trained with the vector
