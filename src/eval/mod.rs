@@ -84,6 +84,24 @@ fn fbm_like(tiles: &[Raster]) -> Vec<Raster> {
         .collect()
 }
 
+/// The realism bar of `generated` against `reference`, with `floor` (other real tiles) as the
+/// real-vs-real floor and fBm matched to each generated tile as the procedural baseline —
+/// what `run` reports, without the table or the image (for calibrating on training tiles).
+/// Seam lines are taken every `seam_stride` pixels from each tile's corner.
+pub fn realism_bar(reference: &[Raster], generated: &[Raster], floor: &[Raster], seam_stride: usize) -> Vec<Target> {
+    let lines = SeamLines::for_origin(seam_stride.max(2), 0, 0);
+    let set = |tiles: &[Raster]| measure::measure(tiles, lines, &mut |_, _| {});
+    let column =
+        |label: &str, tiles: &[Raster]| Column { label: label.into(), colour: Rgb([0, 0, 0]), metrics: set(tiles) };
+    let columns = [
+        column("reference", reference),
+        column("generated", generated),
+        column("fBm", &fbm_like(generated)),
+        column("train (real)", floor),
+    ];
+    Report::new(Vec::new(), &columns, "").targets
+}
+
 /// Runs the evaluation: measures generated, fBm, reference and (for a prepared set) training
 /// tiles, writes the image to `args.out` and returns the table. `progress(done, total)` counts tiles.
 pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report, EvalError> {

@@ -46,7 +46,7 @@ impl Source for ClampedGrid {
 
 /// The core model's terrain (metres) on an `n`×`n` grid conditioned on the low band of `h`
 /// (signed-sqrt elevations of a real tile), and the number of windows it took.
-fn counterpart(model: &LoadedModel, device: &Device, h: &[f32], n: usize, seed: u64) -> (Vec<f32>, u64) {
+pub(super) fn counterpart(model: &LoadedModel, device: &Device, h: &[f32], n: usize, seed: u64) -> (Vec<f32>, u64) {
     // The stage blurs its context itself, so it is given the box means (the clamped extension
     // then blurs exactly as training's lowpass does at tile edges).
     let means = box_downsample(h, n, n, LAPLACIAN_FACTOR);

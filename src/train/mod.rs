@@ -10,6 +10,7 @@
 //! host from ChaCha streams keyed by (seed, step, sample), so a run is a pure function of its
 //! seed and a resumed run continues exactly where the interrupted one left off.
 
+mod calibrate;
 pub mod data;
 mod ema;
 mod heldout;
@@ -103,6 +104,11 @@ pub struct TrainArgs {
     /// `<out>/<stage>.json` on the stage's training data and write it into that manifest.
     #[arg(long)]
     pub fit_relief_hint: bool,
+    /// Instead of training: choose the relief hint's offset of the shipped `<out>/<stage>.json`
+    /// by generating `--tiles` training tiles for a grid of offsets and scoring each set with
+    /// the realism bar (minutes), and write it into that manifest.
+    #[arg(long)]
+    pub calibrate_relief_hint: bool,
     /// Use a very small network and no data files (smoke tests of the training machinery).
     #[arg(long, hide = true)]
     pub smoke: bool,
@@ -176,16 +182,28 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()
         hint.features,
         hint.r2
     );
-    // Only the new key changes: the rest of the file is kept as written (floats included).
-    let mut value: serde_json::Value = serde_json::from_str(&text)?;
-    if let Some(object) = value.as_object_mut() {
-        object.insert("relief_hint".into(), serde_json::to_value(&hint)?);
-    }
+    let hint = serde_json::to_value(&hint)?;
+    edit_manifest(&path, |object| {
+        object.insert("relief_hint".into(), hint);
+        Ok(())
+    })
+}
+
+/// Changes one manifest's JSON object through `edit` and writes it back atomically (temporary
+/// file + rename); every key `edit` leaves alone is kept as written, floats included.
+fn edit_manifest(
+    path: &Path,
+    edit: impl FnOnce(&mut serde_json::Map<String, serde_json::Value>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut value: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let object = value.as_object_mut().ok_or_else(|| anyhow!("{} is not a JSON object", path.display()))?;
+    edit(object)?;
     let tmp = path.with_extension("json.tmp");
     std::fs::write(&tmp, serde_json::to_string_pretty(&value)? + "\n")
-        .and_then(|()| std::fs::rename(&tmp, &path))
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// What a checkpoint records besides tensors.
@@ -249,6 +267,11 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     }
     if args.fit_relief_hint {
         return fit_relief_hint(&args.out, &args.stage, &args.data).map_err(Failure::runtime);
+    }
+    if args.calibrate_relief_hint {
+        let seed = seed.unwrap_or(DEFAULT_SEED);
+        return calibrate::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
+            .map_err(Failure::runtime);
     }
     if args.crop == 0 || args.crop % spec.config.size_multiple().max(8) != 0 {
         return Err(Failure::input(anyhow!("--crop must be a positive multiple of 8, got {}", args.crop)));

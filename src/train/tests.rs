@@ -24,6 +24,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         generate_heldout: None,
         counterpart: None,
         fit_relief_hint: false,
+        calibrate_relief_hint: false,
         picture: PathBuf::from("unused.png"),
         smoke: true,
     }

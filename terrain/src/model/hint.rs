@@ -25,6 +25,12 @@ pub struct ReliefHint {
     pub coefficients: Vec<f64>,
     /// Fraction of the variance of `relief_z` the fit explains on its training crops.
     pub r2: f64,
+    /// Added to every prediction, in z units. A few-step sampler driven by a small, briefly
+    /// trained network draws less relief than the vector asks for (its samples regress
+    /// towards the mean); asking for a little more restores the real amount. Chosen by
+    /// `infiniterra train STAGE --calibrate-relief-hint` on training tiles; 0 until then.
+    #[serde(default)]
+    pub offset: f64,
 }
 
 /// The context statistics of one square window of side `side`: its low band in signed-sqrt
@@ -89,12 +95,13 @@ impl ReliefHint {
             features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
             coefficients,
             r2: if total > 0.0 { 1.0 - residual / total } else { 0.0 },
+            offset: 0.0,
         })
     }
 
     /// The predicted `relief_z` of a window whose low band is `low` (side `side`).
     pub fn predict(&self, low: &[f32], side: usize) -> f32 {
-        features(low, side).iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>() as f32
+        (features(low, side).iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>() + self.offset) as f32
     }
 
     /// Checks the manifest entry has the shape this code computes.
@@ -104,6 +111,9 @@ impl ReliefHint {
         }
         if self.coefficients.len() != FEATURES || self.coefficients.iter().any(|c| !c.is_finite()) {
             return Err(format!("relief_hint.coefficients must be {FEATURES} finite numbers"));
+        }
+        if !self.offset.is_finite() {
+            return Err(format!("relief_hint.offset = {} is not a finite number", self.offset));
         }
         Ok(())
     }
@@ -137,6 +147,10 @@ mod tests {
         assert!(hint.r2 > 0.999_999);
         assert!((hint.predict(&windows[7], side) as f64 - y[7]).abs() < 1e-4);
         hint.validate().expect("fresh fit is valid");
+        // The calibration offset shifts every prediction by itself, nothing else.
+        let shifted = ReliefHint { offset: 0.75, ..hint.clone() };
+        assert!((shifted.predict(&windows[7], side) - hint.predict(&windows[7], side) - 0.75).abs() < 1e-5);
+        assert!(ReliefHint { offset: f64::NAN, ..hint }.validate().unwrap_err().contains("relief_hint.offset"));
     }
 
     #[test]
@@ -144,7 +158,7 @@ mod tests {
         let flat = vec![3.0f32; 64];
         let x = vec![features(&flat, 8); 10];
         assert_eq!(ReliefHint::fit(&x, &[1.0; 10]), None);
-        let bad = ReliefHint { features: vec!["1".into()], coefficients: vec![0.0], r2: 0.0 };
+        let bad = ReliefHint { features: vec!["1".into()], coefficients: vec![0.0], r2: 0.0, offset: 0.0 };
         assert!(bad.validate().unwrap_err().contains("relief_hint.features"));
     }
 }

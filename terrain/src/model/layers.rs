@@ -13,6 +13,7 @@ use burn::tensor::module::conv2d;
 use burn::tensor::ops::ConvOptions;
 use burn::tensor::{Device, Tensor, TensorData};
 
+use super::cpu_conv::{self, Pre};
 use super::rng::HostRng;
 
 /// Keeps the weight norm away from zero (EDM2's value).
@@ -96,7 +97,30 @@ impl MpConv {
         self.conv(x, self.kernel() * gain.reshape([1, 1, 1, 1]))
     }
 
+    /// `conv(mp_silu(x · scale))` with `scale` one factor per image and input channel
+    /// (`[batch, c_in]`) or none: the activation in front of every block convolution. On the
+    /// CPU at inference the activation is fused into the convolution's padding pass.
+    pub fn forward_silu(&self, x: Tensor<4>, scale: Option<Tensor<2>>) -> Tensor<4> {
+        let kernel = self.kernel();
+        if cpu_conv::applies(&x, &kernel) {
+            let factors: Option<Vec<f32>> =
+                scale.map(|s| s.into_data().try_into_vec().expect("f32 modulation on a flex device"));
+            return cpu_conv::conv_same(x, kernel, Pre::Silu(factors.as_deref()));
+        }
+        let x = match scale {
+            Some(s) => {
+                let [b, c] = s.dims();
+                x * s.reshape([b, c, 1, 1])
+            }
+            None => x,
+        };
+        self.conv(mp_silu(x), kernel)
+    }
+
     fn conv(&self, x: Tensor<4>, w: Tensor<4>) -> Tensor<4> {
+        if cpu_conv::applies(&x, &w) {
+            return cpu_conv::conv_same(x, w, Pre::Identity);
+        }
         let k = w.dims()[2];
         let pad = k / 2;
         conv2d(x, w, None, ConvOptions::new([1, 1], [pad, pad], [1, 1], 1))

@@ -10,6 +10,7 @@
 //! model on the infinite grid. Must not touch: the engine's blending and cache (it plugs in
 //! as a [`WindowFn`](crate::infinite::WindowFn)), the pipeline's stage choice, Minecraft.
 
+mod cpu_conv;
 mod edm;
 pub mod hint;
 mod layers;

@@ -118,12 +118,42 @@ fn fixed_inputs(b: usize) -> (Vec<Tensor<4>>, Tensor<4>, Tensor<2>) {
 
 /// A tiny network with non-trivial output (the default has out_gain = 0).
 fn perturbed_tiny(seed: u64) -> UNet {
-    let mut net = UNet::new(&UNetConfig::tiny(), seed, &device());
+    perturbed_tiny_on(seed, &device())
+}
+
+fn perturbed_tiny_on(seed: u64, device: &Device) -> UNet {
+    let mut net = UNet::new(&UNetConfig::tiny(), seed, device);
     net.out_gain = net.out_gain.map(|g| g.add_scalar(0.7));
     for b in net.enc.iter_mut().chain(net.dec.iter_mut()) {
         b.emb_gain = b.emb_gain.clone().map(|g| g.add_scalar(0.3));
     }
     net
+}
+
+#[test]
+fn the_cpu_inference_convolutions_match_burns_own() {
+    // On a plain flex device the network convolves with `cpu_conv` (SiLU and modulation
+    // fused); on an autodiff device it uses burn's kernels. Same weights, same inputs: the
+    // two must agree to float rounding, or inference would not be what training trained.
+    let autodiff = device().autodiff();
+    let fast = perturbed_tiny(5);
+    let reference = perturbed_tiny_on(5, &autodiff);
+    let to = |t: &Tensor<4>| Tensor::<4>::from_data(t.to_data(), &autodiff);
+    let x = randn([2, 1, 16, 16], 40);
+    let cond = randn([2, 1, 16, 16], 41);
+    let vector = Tensor::<2>::from_data(TensorData::new(vec![0.8f32, 1.0, -0.5, 1.0], [2, 2]), &device());
+    let sigma = Tensor::<1>::from_data(TensorData::new(vec![0.7f32, 3.0], [2]), &device());
+    let a = values(fast.denoise(x.clone(), sigma.clone(), Some(cond.clone()), Some(vector.clone())));
+    let b = values(reference.denoise(
+        to(&x),
+        Tensor::from_data(sigma.to_data(), &autodiff),
+        Some(to(&cond)),
+        Some(Tensor::from_data(vector.to_data(), &autodiff)),
+    ));
+    let scale = a.iter().map(|v| v.abs()).fold(0.0f32, f32::max);
+    let worst = a.iter().zip(&b).map(|(p, q)| (p - q).abs()).fold(0.0f32, f32::max);
+    assert!(scale > 0.1, "the network's output is not trivial");
+    assert!(worst < 1e-4 * scale.max(1.0), "fast and burn convolutions differ by {worst}");
 }
 
 #[test]
@@ -359,6 +389,7 @@ fn the_relief_hint_steers_each_window_from_its_own_context() {
         features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
         coefficients: vec![0.5, 0.1, 0.8, 0.3],
         r2: 0.9,
+        offset: 0.2,
     });
     let hinted = LearnedStage::new(LoadedModel { net, manifest: manifest.clone() }, device(), Arc::new(Hills), 42, 2);
     // Each window's vector is the hint's prediction from that window's own low band.

@@ -136,10 +136,9 @@ impl Block {
             }
             x = pixel_norm(x);
         }
-        let y = self.conv0.forward(mp_silu(x.clone()));
-        let [b, c, _, _] = y.dims();
-        let scale = self.emb.forward_gain(emb.clone(), self.emb_gain.val()).add_scalar(1.0).reshape([b, c, 1, 1]);
-        let y = self.conv1.forward(mp_silu(y * scale));
+        let y = self.conv0.forward_silu(x.clone(), None);
+        let scale = self.emb.forward_gain(emb.clone(), self.emb_gain.val()).add_scalar(1.0);
+        let y = self.conv1.forward_silu(y, Some(scale));
         if !self.encoder {
             if let Some(skip) = &self.skip {
                 x = skip.forward(x);
