@@ -76,6 +76,13 @@ pub fn run(
         );
     }
     let train = read_split(&data.join(stage), "train", 1).map_err(|e| anyhow!(e))?;
+    if train.tiles.len() < 4 {
+        anyhow::bail!(
+            "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",
+            data.join(stage).display(),
+            train.tiles.len()
+        );
+    }
     let count = count.clamp(2, train.tiles.len() / 2);
     let metres = model.manifest.metres_per_pixel;
     let tiles = spread(&train.tiles, count, 0.0);

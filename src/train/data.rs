@@ -14,8 +14,8 @@ use infiniterra_terrain::model::{sha256_file, DataChecksum, HostRng, NoiseDistri
 
 use crate::export::read_npy_f32;
 
-/// Side of the prepared tiles.
-const PREPARED_TILE: usize = 256;
+/// Side of every prepared tile (`data prepare` writes stacks of them).
+pub const PREPARED_TILE: usize = 256;
 /// Probability that a sample's conditioning vector is dropped (all zeros), so the network
 /// also works when the pipeline has no relief hint to give.
 const VECTOR_DROPOUT: f64 = 0.2;

@@ -106,3 +106,42 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
     assert!(err.to_string().contains("region.npy"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn calibrating_the_relief_hint_changes_only_its_offset() {
+    let dir = tempdir("calibrate");
+    train(&smoke_args(&dir, 2, false));
+    let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
+    let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
+
+    // Four real-looking 256² training tiles: two to generate, two for the floor.
+    let data_dir = dir.join("data");
+    std::fs::create_dir_all(data_dir.join("core")).expect("data dir");
+    let tiles = data::synthetic(4, data::PREPARED_TILE);
+    let stack: Vec<f32> =
+        tiles.tiles.iter().flat_map(|t| t.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h))).collect();
+    let train_npy = data_dir.join("core/train.npy");
+    crate::export::write_npy_f32(&train_npy, (4 * data::PREPARED_TILE, data::PREPARED_TILE), &stack).expect("write");
+    calibrate::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+
+    let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
+    let offset = after["relief_hint"]["offset"].as_f64().expect("an offset was written");
+    assert!((0.0..=1.3).contains(&offset), "offset {offset} is one of the tried ones");
+    let without_offset = |v: &serde_json::Value| {
+        let mut v = v.clone();
+        v["relief_hint"].as_object_mut().expect("object").remove("offset");
+        v
+    };
+    assert_eq!(without_offset(&after), without_offset(&before), "nothing but the offset changed");
+    assert!(
+        infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).is_ok(),
+        "still loads"
+    );
+
+    // Too few tiles: refused, naming the folder.
+    crate::export::write_npy_f32(&train_npy, (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack[..stack.len() / 2])
+        .expect("write");
+    let err = calibrate::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect_err("two tiles");
+    assert!(err.to_string().contains("at least 4"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
