@@ -49,19 +49,24 @@ pub struct Target {
     pub rule: String,
     /// Whether the value lies in the range.
     pub pass: bool,
+    /// For a distance: the fBm baseline's distance it is judged against (stable, unlike the
+    /// real-vs-real floor, which can be near zero by chance on small sets).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fbm: Option<f64>,
 }
 
 impl Target {
     fn new(key: &str, value: f64, (low, high): (f64, f64), rule: String) -> Target {
         let pass = value.is_finite() && value >= low && value <= high;
-        Target { key: key.into(), value, low, high, rule, pass }
+        Target { key: key.into(), value, low, high, rule, pass, fbm: None }
     }
 
     /// A distance to the reference: at most 2× the real-vs-real floor and at most one fifth
     /// of the fBm baseline's distance.
     fn distance(key: &str, generated: f64, floor: f64, fbm: f64) -> Target {
         let high = (2.0 * floor).min(fbm / 5.0);
-        Target::new(key, generated, (0.0, high), format!("≤ min(2 × floor {floor:.3}, fBm {fbm:.3} / 5)"))
+        let rule = format!("≤ min(2 × floor {floor:.3}, fBm {fbm:.3} / 5)");
+        Target { fbm: Some(fbm), ..Target::new(key, generated, (0.0, high), rule) }
     }
 }
 

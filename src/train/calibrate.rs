@@ -26,17 +26,20 @@ const GRID: [f64; 7] = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2];
 /// Refinement step around the best grid offset.
 const REFINE: f64 = 0.1;
 
-/// How far a generated set is from the bar, averaged over its metrics: each distance as a
-/// fraction of the most it may be, the depression density as |log₂(generated / real)| (1 at
-/// the "within 2×" edge). Below 1 on every metric means the bar is met. Seams do not depend
-/// on the offset and are left out.
+/// How far a generated set is from the bar, averaged over its metrics: each distance in
+/// units of the bar's fBm line (distance / (fBm's distance / 5): 1 on the line), the
+/// depression density as |log₂(generated / real)| (1 at the "within 2×" edge). Below 1 on
+/// every metric means those lines are met. The real-vs-real floor is left out on purpose: on
+/// a few dozen tiles it can be near zero by chance, and dividing by it turns noise into the
+/// score. Seams do not depend on the offset and are left out too.
 pub fn score(targets: &[Target]) -> f64 {
     let parts: Vec<f64> = targets
         .iter()
-        .filter_map(|t| match t.key.as_str() {
-            "seam_ratio" => None,
-            "depressions_per_1000_km2" => Some((t.value / (t.low * t.high).sqrt()).log2().abs()),
-            _ => Some(t.value / t.high.max(f64::MIN_POSITIVE)),
+        .filter_map(|t| match (t.key.as_str(), t.fbm) {
+            ("seam_ratio", _) => None,
+            ("depressions_per_1000_km2", _) => Some((t.value / (t.low * t.high).sqrt()).log2().abs()),
+            (_, Some(fbm)) => Some(t.value / (fbm / 5.0).max(f64::MIN_POSITIVE)),
+            (_, None) => None,
         })
         .collect();
     if parts.iter().any(|p| !p.is_finite()) || parts.is_empty() {
@@ -146,22 +149,29 @@ pub fn run(
 mod tests {
     use super::*;
 
-    fn target(key: &str, value: f64, low: f64, high: f64) -> Target {
-        Target { key: key.into(), value, low, high, rule: String::new(), pass: value >= low && value <= high }
+    fn target(key: &str, value: f64, low: f64, high: f64, fbm: Option<f64>) -> Target {
+        let pass = value >= low && value <= high;
+        Target { key: key.into(), value, low, high, rule: String::new(), pass, fbm }
     }
 
     #[test]
-    fn the_score_is_the_mean_fraction_of_the_allowed_distance() {
-        let at_the_edge = [
-            target("slope_w1_deg", 0.2, 0.0, 0.2),
-            target("depressions_per_1000_km2", 20.0, 5.0, 20.0),
-            target("seam_ratio", 3.0, 0.9, 1.1),
+    fn the_score_counts_distances_in_units_of_the_fbm_line() {
+        let on_the_lines = [
+            target("slope_w1_deg", 0.2, 0.0, 0.2, Some(1.0)),
+            target("depressions_per_1000_km2", 20.0, 5.0, 20.0, None),
+            target("seam_ratio", 3.0, 0.9, 1.1, None),
         ];
-        // Distance at its limit: 1; depressions 2× real: |log₂ 2| = 1; seams ignored.
-        assert!((score(&at_the_edge) - 1.0).abs() < 1e-12);
-        let better = [target("slope_w1_deg", 0.1, 0.0, 0.2), target("depressions_per_1000_km2", 10.0, 5.0, 20.0)];
+        // Distance at fBm / 5: 1; depressions 2× real: |log₂ 2| = 1; seams ignored.
+        assert!((score(&on_the_lines) - 1.0).abs() < 1e-12);
+        let better = [
+            target("slope_w1_deg", 0.1, 0.0, 0.2, Some(1.0)),
+            target("depressions_per_1000_km2", 10.0, 5.0, 20.0, None),
+        ];
         assert!((score(&better) - 0.25).abs() < 1e-12);
-        let broken = [target("slope_w1_deg", f64::NAN, 0.0, 0.2)];
+        // A near-zero floor (tiny `high`) does not blow the score up: only fBm scales it.
+        let tiny_floor = [target("slope_w1_deg", 0.1, 0.0, 1e-9, Some(1.0))];
+        assert!((score(&tiny_floor) - 0.5).abs() < 1e-12);
+        let broken = [target("slope_w1_deg", f64::NAN, 0.0, 0.2, Some(1.0))];
         assert_eq!(score(&broken), f64::INFINITY);
     }
 }
