@@ -18,8 +18,7 @@
 use burn::tensor::{Device, Tensor, TensorData};
 use rayon::prelude::*;
 
-/// E[silu(x)²]^½ for x ~ N(0, 1), as in [`super::layers`].
-const SILU_MAGNITUDE: f32 = 0.596;
+use super::layers::SILU_MAGNITUDE;
 
 /// Output positions (in the padded row stride) per GEMM: the band's right-hand side,
 /// `k²·c_in` rows of this many floats, stays within L2.

@@ -20,7 +20,7 @@ use super::rng::HostRng;
 const NORM_EPS: f32 = 1e-4;
 
 /// E[silu(x)²]^½ for x ~ N(0, 1): dividing by it keeps unit magnitude (EDM2's constant).
-const SILU_MAGNITUDE: f32 = 0.596;
+pub(super) const SILU_MAGNITUDE: f32 = 0.596;
 
 /// Normalises every "row" (everything but dim 0) of a weight to RMS 1, i.e. to norm √fan_in.
 pub fn normalize_rows<const D: usize>(w: Tensor<D>) -> Tensor<D> {
