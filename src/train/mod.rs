@@ -26,8 +26,8 @@ use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
 use burn::tensor::{Device, Tensor, TensorData};
 use infiniterra_terrain::model::{
-    edm_loss, force_normalize, save_model, ComputeBackend, DataChecksum, ModelManifest, NoiseDistribution,
-    Normalisation, Precision, Sampler, TrainingRecord, UNet, UNetConfig,
+    edm_loss, force_normalize, load_model_file, save_model, ComputeBackend, DataChecksum, ModelManifest,
+    NoiseDistribution, Normalisation, Precision, Sampler, TrainingRecord, UNet, UNetConfig,
 };
 use serde::{Deserialize, Serialize};
 
@@ -46,6 +46,12 @@ pub struct TrainArgs {
     /// Continue from the stage's checkpoint in `<out>/checkpoints/<stage>/`.
     #[arg(long)]
     pub resume: bool,
+    /// Continue training a shipped model (its manifest, e.g. `models/core.json`) when its
+    /// checkpoint is gone: network and EMA start from its weights, and the step count,
+    /// normalisation, batch, crop, seed and schedule from its training record (so the data
+    /// stream and learning rate carry on); only the optimiser's moments start afresh.
+    #[arg(long, conflicts_with = "resume")]
+    pub init_from: Option<PathBuf>,
     /// Samples per step.
     #[arg(long, default_value_t = 8)]
     pub batch: usize,
@@ -224,6 +230,10 @@ struct CheckpointState {
     losses: Vec<(u64, f32)>,
     /// (step, validation loss).
     validation: Vec<(u64, f32)>,
+    /// For a run started with `--init-from`: the command that made the weights it started
+    /// from, and that manifest's path (both go into the shipped `recreate`).
+    #[serde(default)]
+    continues: Option<(String, PathBuf)>,
 }
 
 /// Paths of a stage's checkpoint.
@@ -353,6 +363,45 @@ impl Trainer {
                 .map_err(|e| Failure::input(anyhow!("cannot resume from {}: {e}", paths.optim().display())))?;
             eprintln!("resuming {} at step {} (seed {})", state.stage, state.step, state.seed);
             (net, ema, optim, state)
+        } else if let Some(path) = &args.init_from {
+            let load =
+                |dev: &Device| load_model_file(path, dev).map_err(|e| Failure::input(anyhow!("--init-from: {e}")));
+            let shipped = load(&plain)?;
+            let m = &shipped.manifest;
+            if m.stage != args.stage || m.architecture != spec.config {
+                return Err(Failure::input(anyhow!(
+                    "--init-from {}: a `{}` model of another architecture cannot continue as stage `{}`",
+                    path.display(),
+                    m.stage,
+                    args.stage
+                )));
+            }
+            let t = &m.training;
+            let state = CheckpointState {
+                stage: args.stage.clone(),
+                step: t.steps,
+                seed: t.seed,
+                batch: t.batch,
+                crop: t.crop,
+                lr: t.learning_rate,
+                lr_ref_steps: if t.lr_ref_steps > 0 { t.lr_ref_steps } else { args.lr_ref_steps },
+                ema: t.ema_beta,
+                config: m.architecture.clone(),
+                normalisation: m.normalisation.clone(),
+                wall_seconds: t.wall_seconds,
+                losses: Vec::new(),
+                validation: Vec::new(),
+                continues: Some((m.recreate.clone(), path.clone())),
+            };
+            eprintln!(
+                "continuing {} from {} at step {} (seed {})",
+                state.stage,
+                path.display(),
+                state.step,
+                state.seed
+            );
+            let net = load(&device)?.net;
+            (net, shipped.net, optim, state)
         } else {
             let normalisation = train.normalisation(args.crop, spec.config.sigma_data);
             let net = UNet::new(&spec.config, seed, &device);
@@ -371,6 +420,7 @@ impl Trainer {
                 wall_seconds: 0.0,
                 losses: Vec::new(),
                 validation: Vec::new(),
+                continues: None,
             };
             (net, ema, optim, state)
         };
@@ -570,6 +620,7 @@ impl Trainer {
             seed: self.state.seed,
             learning_rate: self.state.lr,
             ema_beta: self.state.ema,
+            lr_ref_steps: self.state.lr_ref_steps,
             final_loss: self.state.losses.last().map_or(f32::NAN, |l| l.1),
             wall_seconds: self.state.wall_seconds,
         };
@@ -589,9 +640,10 @@ impl Trainer {
         // The command that reproduces these exact weights (a --minutes run stops at a
         // machine-dependent step; this names the step it reached).
         let s = &self.state;
-        manifest.recreate = format!(
-            "infiniterra train {} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {} --precision {}",
+        let this_run = format!(
+            "infiniterra train {}{} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {} --precision {}",
             s.stage,
+            s.continues.as_ref().map_or(String::new(), |(_, from)| format!(" --init-from {}", from.display())),
             s.step,
             s.seed,
             s.batch,
@@ -604,6 +656,12 @@ impl Trainer {
                 Precision::F32 => "f32",
             }
         );
+        // A continued run is reproduced by the commands that made its starting point, then
+        // this one (which reads the manifest the earlier ones wrote).
+        manifest.recreate = match &s.continues {
+            Some((before, _)) if !before.is_empty() => format!("{before} && {this_run}"),
+            _ => this_run,
+        };
         if let Some(&(_, v)) = self.state.validation.last() {
             manifest.realism.insert("validation_edm_loss".into(), v as f64);
         }

@@ -7,6 +7,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         stage: "core".into(),
         steps,
         resume,
+        init_from: None,
         batch: 2,
         crop: 32,
         lr: 4e-3,
@@ -68,6 +69,44 @@ fn training_is_deterministic_and_resumes_exactly() {
     assert!(resumed.join("checkpoints/core/samples_000004.png").exists());
     let _ = std::fs::remove_dir_all(&straight);
     let _ = std::fs::remove_dir_all(&resumed);
+}
+
+#[test]
+fn a_shipped_model_continues_training_from_its_weights_and_step() {
+    let first = tempdir("first");
+    train(&smoke_args(&first, 2, false));
+    let continued = tempdir("continued");
+    let mut args = smoke_args(&continued, 4, false);
+    args.init_from = Some(first.join("core.json"));
+    // Different settings on the command line are overridden by the shipped record.
+    args.batch = 3;
+    let state = train(&args);
+    assert_eq!((state.step, state.batch), (4, 2), "continues at the shipped step with the shipped batch");
+    assert!(state.losses.iter().all(|&(k, l)| k > 2 && l.is_finite()), "{:?}", state.losses);
+    let weights = |d: &Path| std::fs::read(d.join("core.safetensors")).expect("shipped weights");
+    assert_ne!(weights(&first), weights(&continued), "the optimiser moved the loaded weights");
+    let manifest: ModelManifest =
+        serde_json::from_str(&std::fs::read_to_string(continued.join("core.json")).expect("manifest")).expect("parses");
+    let start: ModelManifest =
+        serde_json::from_str(&std::fs::read_to_string(first.join("core.json")).expect("manifest")).expect("parses");
+    assert_eq!(manifest.training.steps, 4);
+    assert_eq!(manifest.normalisation, start.normalisation, "normalisation is the shipped one");
+    let (before, after) = manifest.recreate.split_once(" && ").expect("recreate chains both runs");
+    assert_eq!(before, start.recreate);
+    assert!(after.contains("--init-from ") && after.contains("--steps 4"), "{after}");
+
+    // Another stage's (or architecture's) manifest is refused, naming the file.
+    let mut wrong = smoke_args(&tempdir("wrong"), 4, false);
+    wrong.init_from = Some(first.join("core.json"));
+    wrong.stage = "coarse".into();
+    let spec = stage_spec("coarse", true).expect("coarse is trainable");
+    let err = Trainer::new(&wrong, 0, spec, data::synthetic(2, 64), data::synthetic(1, 64))
+        .err()
+        .expect("a core model cannot continue as coarse");
+    assert_eq!(err.code, 2);
+    assert!(err.error.to_string().contains("core.json"), "{}", err.error);
+    let _ = std::fs::remove_dir_all(&first);
+    let _ = std::fs::remove_dir_all(&continued);
 }
 
 #[test]

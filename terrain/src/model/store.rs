@@ -72,6 +72,9 @@ pub struct TrainingRecord {
     pub learning_rate: f32,
     /// EMA decay of the shipped weights.
     pub ema_beta: f32,
+    /// Steps before the learning rate decays (0 in manifests written before it was recorded).
+    #[serde(default)]
+    pub lr_ref_steps: u64,
     /// Mean loss over the last logging interval.
     pub final_loss: f32,
     /// Wall-clock seconds spent training (all sessions).
