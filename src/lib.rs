@@ -12,6 +12,7 @@ pub mod config;
 pub mod eval;
 pub mod export;
 pub mod fill;
+pub mod manifest_edit;
 pub mod pregen;
 pub mod render;
 pub mod server;

@@ -160,24 +160,16 @@ fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
             path.display()
         )));
     }
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| EvalError::Input(format!("--record {}: cannot read it: {e}", path.display())))?;
-    let mut manifest: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| EvalError::Input(format!("--record {}: not JSON: {e}", path.display())))?;
-    let Some(object) = manifest.as_object_mut() else {
-        return Err(EvalError::Input(format!("--record {}: not a JSON object", path.display())));
-    };
     let mut realism = serde_json::Map::new();
     for t in &report.targets {
         realism.insert(t.key.clone(), serde_json::json!(t.value));
         realism.insert(format!("{}_met", t.key), serde_json::json!(if t.pass { 1.0 } else { 0.0 }));
     }
-    object.insert("realism".into(), serde_json::Value::Object(realism));
-    let tmp = path.with_extension("json.tmp");
-    let out = serde_json::to_string_pretty(&manifest).expect("JSON values serialise");
-    std::fs::write(&tmp, out + "\n")
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|e| EvalError::Input(format!("--record {}: cannot write it: {e}", path.display())))
+    crate::manifest_edit::edit_manifest(path, |object| {
+        object.insert("realism".into(), serde_json::Value::Object(realism));
+        Ok(())
+    })
+    .map_err(|e| EvalError::Input(format!("--record: {e:#}")))
 }
 
 /// The generated map's seam sums on its own window lines (whole map: its origin places the

@@ -135,7 +135,7 @@ pub fn run(
     let (best, best_score) = tried.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).expect("offsets were tried");
     println!("relief hint of {}: offset {best:+.2} (score {best_score:.3}; tried {tried:?})", path.display());
 
-    super::edit_manifest(&path, |object| {
+    crate::manifest_edit::edit_manifest(&path, |object| {
         let hint = object
             .get_mut("relief_hint")
             .and_then(|h| h.as_object_mut())

@@ -189,27 +189,10 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()
         hint.r2
     );
     let hint = serde_json::to_value(&hint)?;
-    edit_manifest(&path, |object| {
+    crate::manifest_edit::edit_manifest(&path, |object| {
         object.insert("relief_hint".into(), hint);
         Ok(())
     })
-}
-
-/// Changes one manifest's JSON object through `edit` and writes it back atomically (temporary
-/// file + rename); every key `edit` leaves alone is kept as written, floats included.
-fn edit_manifest(
-    path: &Path,
-    edit: impl FnOnce(&mut serde_json::Map<String, serde_json::Value>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut value: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
-    let object = value.as_object_mut().ok_or_else(|| anyhow!("{} is not a JSON object", path.display()))?;
-    edit(object)?;
-    let tmp = path.with_extension("json.tmp");
-    std::fs::write(&tmp, serde_json::to_string_pretty(&value)? + "\n")
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// What a checkpoint records besides tensors.
