@@ -78,7 +78,7 @@ pub fn run(
             path.display()
         );
     }
-    let train = read_split(&data.join(stage), "train", 1).map_err(|e| anyhow!(e))?;
+    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
     if train.tiles.len() < 4 {
         anyhow::bail!(
             "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",
@@ -91,7 +91,7 @@ pub fn run(
     let tiles = spread(&train.tiles, count, 0.0);
     let floor: Vec<Raster> = spread(&train.tiles, count, 0.5).into_iter().map(|t| raster(t, metres)).collect();
     let reference: Vec<Raster> = tiles.iter().map(|t| raster(t, metres)).collect();
-    let seam_stride = model.manifest.window / 2;
+    let seam_stride = model.manifest.window_stride();
 
     let started = Instant::now();
     let mut tried: Vec<(f64, f64)> = Vec::new();

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use infiniterra_terrain::encoding::{lowpass, signed_sqrt, upsample_low, LAPLACIAN_FACTOR};
+use infiniterra_terrain::encoding::{signed_sqrt, ContextSpec};
 use infiniterra_terrain::model::hint::{features, FEATURES};
 use infiniterra_terrain::model::{sha256_file, DataChecksum, HostRng, NoiseDistribution, Normalisation, ReliefHint};
 
@@ -34,16 +34,16 @@ pub struct EncodedTile {
     pub size: usize,
     /// `signed_sqrt(elevation)`.
     pub h: Vec<f32>,
-    /// `upsample(lowpass(h))`: the smooth context.
+    /// `spec.smooth(h)`: the smooth context.
     pub low: Vec<f32>,
 }
 
 impl EncodedTile {
-    /// Encodes a square tile of elevations in metres.
-    pub fn from_metres(size: usize, metres: &[f32]) -> EncodedTile {
+    /// Encodes a square tile of elevations in metres, with the context `spec` makes.
+    pub fn from_metres(size: usize, metres: &[f32], spec: ContextSpec) -> EncodedTile {
         assert_eq!(metres.len(), size * size);
         let h: Vec<f32> = metres.iter().map(|&e| signed_sqrt(e)).collect();
-        let low = upsample_low(&lowpass(&h, size, size), size, size);
+        let low = spec.smooth(&h, size, size);
         EncodedTile { size, h, low }
     }
 }
@@ -78,9 +78,9 @@ pub struct Batch {
     pub low: Vec<f32>,
 }
 
-/// Reads `<dir>/<split>.npy` (tiles stacked along rows) and box-downsamples each tile by
-/// `downsample` (2 turns the 500 m detail set into 1 km tiles).
-pub fn read_split(dir: &Path, split: &str, downsample: usize) -> Result<TileSet, String> {
+/// Reads `<dir>/<split>.npy` (tiles stacked along rows), box-downsamples each tile by
+/// `downsample` (2 turns the 500 m detail set into 1 km tiles) and encodes it with `spec`.
+pub fn read_split(dir: &Path, split: &str, downsample: usize, spec: ContextSpec) -> Result<TileSet, String> {
     let path: PathBuf = dir.join(format!("{split}.npy"));
     let ((rows, cols), data) = read_npy_f32(&path)
         .map_err(|e| format!("{e} (prepare the data with `infiniterra data fetch` and `infiniterra data prepare`)"))?;
@@ -101,7 +101,7 @@ pub fn read_split(dir: &Path, split: &str, downsample: usize) -> Result<TileSet,
                     small[(y / f) * size + x / f] += t[y * PREPARED_TILE + x] / (f * f) as f32;
                 }
             }
-            EncodedTile::from_metres(size, &small)
+            EncodedTile::from_metres(size, &small, spec)
         })
         .collect();
     let sha256 = sha256_file(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
@@ -209,7 +209,7 @@ impl TileSet {
         noise: &NoiseDistribution,
         dropout: bool,
     ) -> Batch {
-        assert!(!self.tiles.is_empty() && crop % LAPLACIAN_FACTOR == 0 && crop <= self.min_tile());
+        assert!(!self.tiles.is_empty() && crop % 8 == 0 && crop <= self.min_tile());
         let n = crop * crop;
         let mut b = Batch {
             size,
@@ -274,6 +274,11 @@ fn crop_of(
 
 /// Synthetic terrain-like tiles (no data files needed): for tests and `--smoke` runs.
 pub fn synthetic(count: usize, size: usize) -> TileSet {
+    synthetic_with(count, size, ContextSpec::default())
+}
+
+/// [`synthetic`] tiles encoded with the context `spec`.
+pub fn synthetic_with(count: usize, size: usize, spec: ContextSpec) -> TileSet {
     let tiles = (0..count)
         .map(|k| {
             let metres: Vec<f32> = (0..size * size)
@@ -283,7 +288,7 @@ pub fn synthetic(count: usize, size: usize) -> TileSet {
                     900.0 * (x * 0.05 + p).sin() * (y * 0.04).cos() + 150.0 * (x * 0.7 + y * 0.3 + p).sin() + 100.0
                 })
                 .collect();
-            EncodedTile::from_metres(size, &metres)
+            EncodedTile::from_metres(size, &metres, spec)
         })
         .collect();
     TileSet { tiles, checksums: Vec::new() }
@@ -306,7 +311,7 @@ mod tests {
                         a * 4.0 * (x * 0.04 + k as f32).sin() * (y * 0.03).cos() + a * (x * 0.9 + y * 0.4).sin() + 500.0
                     })
                     .collect();
-                EncodedTile::from_metres(size, &metres)
+                EncodedTile::from_metres(size, &metres, ContextSpec::default())
             })
             .collect();
         let set = TileSet { tiles, checksums: Vec::new() };

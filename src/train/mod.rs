@@ -33,12 +33,13 @@ use serde::{Deserialize, Serialize};
 
 use self::data::{read_split, Batch, TileSet};
 use crate::cli::Failure;
+use infiniterra_terrain::encoding::ContextSpec;
 use infiniterra_terrain::model::burn;
 
 /// Arguments of `infiniterra train`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct TrainArgs {
-    /// Stage to train (`coarse` or `core`; `detail` is not trainable yet).
+    /// Stage to train: `coarse`, `core` or `detail`.
     pub stage: String,
     /// Total optimiser steps (a resumed run continues up to this count).
     #[arg(long, default_value_t = 4000)]
@@ -140,33 +141,52 @@ struct StageSpec {
     metres_per_pixel: f64,
     config: UNetConfig,
     sampler: Sampler,
+    /// How its context is made from the grid above it.
+    context: ContextSpec,
+    /// Window stride at inference (0: half the window).
+    stride: usize,
 }
 
 fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, Failure> {
+    let pick = |full: UNetConfig| if smoke { UNetConfig::tiny() } else { full };
     match stage {
         "core" => Ok(StageSpec {
             metres_per_pixel: 1000.0,
-            config: if smoke { UNetConfig::tiny() } else { UNetConfig::core() },
+            config: pick(UNetConfig::core()),
             sampler: Sampler::few_step(),
+            context: ContextSpec::default(),
+            stride: 0,
         }),
         // The same network one level up: 8 km relief (continents, shelves, basins) from the
         // 64 km means of the layout.
         "coarse" => Ok(StageSpec {
             metres_per_pixel: 8000.0,
-            config: if smoke { UNetConfig::tiny() } else { UNetConfig::core() },
+            config: pick(UNetConfig::core()),
             sampler: Sampler::few_step(),
+            context: ContextSpec::default(),
+            stride: 0,
         }),
-        "detail" => Err(Failure::input(anyhow!("stage `detail` is not trainable yet; trainable: coarse, core"))),
+        // The last stage: 500 m relief over the core's own 1 km grid, unblurred (the core's
+        // relief is kept; only what is finer than 1 km is generated), with the paper's 75 %
+        // window overlap for the decoder.
+        "detail" => Ok(StageSpec {
+            metres_per_pixel: 500.0,
+            config: pick(UNetConfig::detail()),
+            sampler: Sampler::few_step(),
+            context: ContextSpec { factor: 2, blur: false },
+            stride: 16,
+        }),
         _ => Err(Failure::input(anyhow!("unknown stage `{stage}` (stages: coarse, core, detail)"))),
     }
 }
 
-/// Loads a stage's prepared set (`<dir>/<stage>/`), train and held-out: ETOPO5 8 km tiles for
-/// coarse, GLOBE 1 km tiles for core. The 500 m GEBCO tiles are not added to the core's
-/// (downsampled): they cover Kyrgyzstan, inside the core set's held-out band (60–90°E), so
-/// training on them would leak held-out terrain into the model.
-fn stage_data(stage: &str, dir: &Path) -> Result<(TileSet, TileSet), String> {
-    Ok((read_split(&dir.join(stage), "train", 1)?, read_split(&dir.join(stage), "heldout", 1)?))
+/// Loads a stage's prepared set (`<dir>/<stage>/`), train and held-out, encoded with the
+/// stage's context: ETOPO5 8 km tiles for coarse, GLOBE 1 km tiles for core, GEBCO 500 m
+/// tiles (Kyrgyzstan) for detail. The 500 m tiles are not added to the core's (downsampled):
+/// they lie inside the core set's held-out band (60–90°E), so training on them would leak
+/// held-out terrain into the core.
+fn stage_data(stage: &str, dir: &Path, spec: ContextSpec) -> Result<(TileSet, TileSet), String> {
+    Ok((read_split(&dir.join(stage), "train", 1, spec)?, read_split(&dir.join(stage), "heldout", 1, spec)?))
 }
 
 /// Fits the relief hint of the shipped `<models>/<stage>.json` on the stage's training data
@@ -177,7 +197,7 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()
     let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let manifest: ModelManifest =
         serde_json::from_str(&text).with_context(|| format!("{} is not a model manifest", path.display()))?;
-    let (train, _) = stage_data(stage, data).map_err(|e| anyhow!(e))?;
+    let (train, _) = stage_data(stage, data, manifest.context).map_err(|e| anyhow!(e))?;
     let hint = train
         .relief_hint(manifest.training.crop, &manifest.normalisation)
         .ok_or_else(|| anyhow!("{}: the relief-hint fit is singular on this data", data.display()))?;
@@ -273,9 +293,9 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
         return Err(Failure::input(anyhow!("--batch must be ≥ 1, --ema in [0, 1), --lr > 0")));
     }
     let (train, heldout) = if args.smoke {
-        (data::synthetic(6, 128), data::synthetic(2, 128))
+        (data::synthetic_with(6, 128, spec.context), data::synthetic_with(2, 128, spec.context))
     } else {
-        stage_data(&args.stage, &args.data).map_err(|e| Failure::input(anyhow!(e)))?
+        stage_data(&args.stage, &args.data, spec.context).map_err(|e| Failure::input(anyhow!(e)))?
     };
     if train.min_tile() < args.crop {
         return Err(Failure::input(anyhow!("--crop {} exceeds the smallest tile ({})", args.crop, train.min_tile())));
@@ -300,6 +320,8 @@ pub struct Trainer {
     args: TrainArgs,
     spec_metres: f64,
     sampler: Sampler,
+    context: ContextSpec,
+    stride: usize,
     device: Device,
     plain: Device,
     net: UNet,
@@ -351,7 +373,7 @@ impl Trainer {
                 |dev: &Device| load_model_file(path, dev).map_err(|e| Failure::input(anyhow!("--init-from: {e}")));
             let shipped = load(&plain)?;
             let m = &shipped.manifest;
-            if m.stage != args.stage || m.architecture != spec.config {
+            if m.stage != args.stage || m.architecture != spec.config || m.context != spec.context {
                 return Err(Failure::input(anyhow!(
                     "--init-from {}: a `{}` model of another architecture cannot continue as stage `{}`",
                     path.display(),
@@ -411,6 +433,8 @@ impl Trainer {
             args: args.clone(),
             spec_metres: spec.metres_per_pixel,
             sampler: spec.sampler,
+            context: spec.context,
+            stride: spec.stride,
             device,
             plain,
             net,
@@ -594,6 +618,8 @@ impl Trainer {
         let mut manifest = ModelManifest::new(&self.args.stage, self.state.config.clone(), self.sampler.clone());
         manifest.metres_per_pixel = self.spec_metres;
         manifest.window = 64;
+        manifest.stride = self.stride;
+        manifest.context = self.context;
         manifest.normalisation = self.state.normalisation.clone();
         manifest.relief_hint = self.train.relief_hint(self.state.crop, &self.state.normalisation);
         manifest.training = TrainingRecord {

@@ -110,6 +110,27 @@ fn a_shipped_model_continues_training_from_its_weights_and_step() {
 }
 
 #[test]
+fn the_detail_stage_trains_on_its_own_context_and_ships_its_overlap() {
+    let dir = tempdir("detail");
+    let mut args = smoke_args(&dir, 2, false);
+    args.stage = "detail".into();
+    let spec = stage_spec("detail", true).expect("detail is trainable");
+    let context = spec.context;
+    assert_eq!((context.factor, context.blur), (2, false));
+    let (train_set, heldout) = (data::synthetic_with(6, 128, context), data::synthetic_with(2, 128, context));
+    // A 2× unblurred context leaves a much smaller residual than the core's 8× blurred one.
+    let residual = |t: &TileSet| t.tiles[0].h.iter().zip(&t.tiles[0].low).map(|(h, l)| (h - l).abs()).sum::<f32>();
+    assert!(residual(&train_set) < residual(&data::synthetic(6, 128)) / 2.0);
+    let mut t = Trainer::new(&args, 5, spec, train_set, heldout).expect("trainer");
+    t.run(&AtomicBool::new(false)).expect("training runs");
+    let model = infiniterra_terrain::model::load_model(&dir, "detail", &burn::tensor::Device::flex()).expect("loads");
+    assert_eq!(model.manifest.context, context);
+    assert_eq!((model.manifest.window, model.manifest.window_stride()), (64, 16), "75 % overlap");
+    assert_eq!(model.manifest.metres_per_pixel, 500.0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn resuming_without_a_checkpoint_is_an_input_error() {
     let dir = tempdir("nockpt");
     let spec = stage_spec("core", true).expect("core");

@@ -49,7 +49,7 @@ pub struct EngineSettings {
 }
 
 /// Learned stages that exist (have code and can be trained).
-pub const LEARNED_STAGES: [&str; 2] = ["coarse", "core"];
+pub const LEARNED_STAGES: [&str; 3] = ["coarse", "core", "detail"];
 
 impl Default for EngineSettings {
     fn default() -> Self {
@@ -83,6 +83,14 @@ impl EngineSettings {
                     allowed: format!("stages with a model: {:?}", LEARNED_STAGES),
                 });
             }
+        }
+        // The detail model refines the core's output; without the core it has nothing to refine.
+        if self.learned.iter().any(|s| s == "detail") && !self.learned.iter().any(|s| s == "core") {
+            return Err(RangeError {
+                key: "engine.learned".into(),
+                value: format!("{:?}", self.learned),
+                allowed: "\"detail\" only together with \"core\" (it refines the core's relief)".into(),
+            });
         }
         Ok(())
     }

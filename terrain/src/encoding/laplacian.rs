@@ -52,30 +52,91 @@ pub fn blur(x: &[f32], h: usize, w: usize) -> Vec<f32> {
 
 /// The low-frequency channel of an `h × w` image: `(h/8) × (w/8)` values.
 pub fn lowpass(x: &[f32], h: usize, w: usize) -> Vec<f32> {
-    assert!(h % LAPLACIAN_FACTOR == 0 && w % LAPLACIAN_FACTOR == 0, "{h}×{w} is not a multiple of {LAPLACIAN_FACTOR}");
-    blur(&downsample(x, h, w, LAPLACIAN_FACTOR), h / LAPLACIAN_FACTOR, w / LAPLACIAN_FACTOR)
+    ContextSpec::default().lowpass(x, h, w)
 }
 
 /// Bilinear upsampling of the low channel back to `h × w` (cell centres aligned, edges clamped).
 pub fn upsample_low(low: &[f32], h: usize, w: usize) -> Vec<f32> {
-    let f = LAPLACIAN_FACTOR as f32;
-    let (lh, lw) = (h / LAPLACIAN_FACTOR, w / LAPLACIAN_FACTOR);
-    let tap = |d: usize, n: usize| {
-        let c = ((d as f32 + 0.5) / f - 0.5).clamp(0.0, (n - 1) as f32);
-        let i = (c.floor() as usize).min(n.saturating_sub(2));
-        (i, (c - i as f32).min(1.0), (i + 1).min(n - 1))
-    };
-    let mut out = vec![0.0; h * w];
-    for y in 0..h {
-        let (y0, ty, y1) = tap(y, lh);
-        for x in 0..w {
-            let (x0, tx, x1) = tap(x, lw);
-            let top = low[y0 * lw + x0] + tx * (low[y0 * lw + x1] - low[y0 * lw + x0]);
-            let bottom = low[y1 * lw + x0] + tx * (low[y1 * lw + x1] - low[y1 * lw + x0]);
-            out[y * w + x] = top + ty * (bottom - top);
+    ContextSpec::default().upsample(low, h, w)
+}
+
+/// How a learned stage's context (its low band) is made from the full-resolution signal:
+/// box means over `factor`² pixels, optionally blurred by [`blur`], and bilinearly upsampled
+/// back. The core uses the default (8×, blurred: the paper's Laplacian split); a stage that
+/// refines a grid only 2× coarser than its own (detail over core) keeps the coarse grid's
+/// values unblurred, so the relief above it is not thrown away and regenerated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContextSpec {
+    /// Output pixels per context cell, per axis.
+    pub factor: usize,
+    /// Whether the box means are blurred ([`BLUR_RADIUS`] extra cells read on each side).
+    pub blur: bool,
+}
+
+impl Default for ContextSpec {
+    fn default() -> ContextSpec {
+        ContextSpec { factor: LAPLACIAN_FACTOR, blur: true }
+    }
+}
+
+impl ContextSpec {
+    /// Refuses a factor the encodings cannot use (names the value).
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=16).contains(&self.factor) {
+            return Err(format!("context.factor = {} (must be 1 to 16)", self.factor));
+        }
+        Ok(())
+    }
+
+    /// Extra context cells a window needs on each side (the blur's reach).
+    pub fn margin(&self) -> usize {
+        if self.blur {
+            BLUR_RADIUS
+        } else {
+            0
         }
     }
-    out
+
+    /// The low channel of an `h × w` image: `(h/f) × (w/f)` values.
+    pub fn lowpass(&self, x: &[f32], h: usize, w: usize) -> Vec<f32> {
+        let f = self.factor;
+        assert!(h % f == 0 && w % f == 0, "{h}×{w} is not a multiple of {f}");
+        let means = downsample(x, h, w, f);
+        if self.blur {
+            blur(&means, h / f, w / f)
+        } else {
+            means
+        }
+    }
+
+    /// Bilinear upsampling of a low channel back to `h × w` (cell centres aligned, edges
+    /// clamped).
+    pub fn upsample(&self, low: &[f32], h: usize, w: usize) -> Vec<f32> {
+        let f = self.factor as f32;
+        let (lh, lw) = (h / self.factor, w / self.factor);
+        let tap = |d: usize, n: usize| {
+            let c = ((d as f32 + 0.5) / f - 0.5).clamp(0.0, (n - 1) as f32);
+            let i = (c.floor() as usize).min(n.saturating_sub(2));
+            (i, (c - i as f32).min(1.0), (i + 1).min(n - 1))
+        };
+        let mut out = vec![0.0; h * w];
+        for y in 0..h {
+            let (y0, ty, y1) = tap(y, lh);
+            for x in 0..w {
+                let (x0, tx, x1) = tap(x, lw);
+                let top = low[y0 * lw + x0] + tx * (low[y0 * lw + x1] - low[y0 * lw + x0]);
+                let bottom = low[y1 * lw + x0] + tx * (low[y1 * lw + x1] - low[y1 * lw + x0]);
+                out[y * w + x] = top + ty * (bottom - top);
+            }
+        }
+        out
+    }
+
+    /// `upsample(lowpass(x))`: the smooth context of an image, at its own size.
+    pub fn smooth(&self, x: &[f32], h: usize, w: usize) -> Vec<f32> {
+        self.upsample(&self.lowpass(x, h, w), h, w)
+    }
 }
 
 /// Splits an image into its low-frequency channel and the residual.
@@ -132,6 +193,26 @@ mod tests {
         let (low, res) = laplacian_split(&x, h, w);
         let mean = |v: &[f32]| v.iter().map(|a| a.abs()).sum::<f32>() / v.len() as f32;
         assert!(mean(&low) > 3.0 * mean(&res), "low {} residual {}", mean(&low), mean(&res));
+    }
+
+    #[test]
+    fn a_context_spec_generalises_the_laplacian_split() {
+        let (h, w) = (64, 48);
+        let x = terrain_like(h, w);
+        assert_eq!(ContextSpec::default().smooth(&x, h, w), upsample_low(&lowpass(&x, h, w), h, w));
+        // 2×, unblurred: the low channel is the plain 2×2 means, and a field constant over
+        // each cell pair comes back exactly where bilinear weights stay inside one cell row.
+        let two = ContextSpec { factor: 2, blur: false };
+        let low = two.lowpass(&x, h, w);
+        assert_eq!(low.len(), (h / 2) * (w / 2));
+        let mean = (x[0] + x[1] + x[w] + x[w + 1]) / 4.0;
+        assert!((low[0] - mean).abs() < 1e-3);
+        let smooth = two.smooth(&x, h, w);
+        let err = x.iter().zip(&smooth).map(|(a, b)| (a - b).abs()).sum::<f32>() / x.len() as f32;
+        let err8 = x.iter().zip(ContextSpec::default().smooth(&x, h, w)).map(|(a, b)| (a - b).abs()).sum::<f32>()
+            / x.len() as f32;
+        assert!(err < err8 / 2.0, "a 2× unblurred context keeps more: {err} vs {err8}");
+        assert!(ContextSpec { factor: 0, blur: true }.validate().unwrap_err().contains("context.factor = 0"));
     }
 
     #[test]

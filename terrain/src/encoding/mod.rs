@@ -7,8 +7,8 @@
 mod laplacian;
 
 pub use laplacian::{
-    blur, box_downsample, laplacian_denoise, laplacian_merge, laplacian_split, lowpass, upsample_low, BLUR_RADIUS,
-    LAPLACIAN_FACTOR,
+    blur, box_downsample, laplacian_denoise, laplacian_merge, laplacian_split, lowpass, upsample_low, ContextSpec,
+    BLUR_RADIUS, LAPLACIAN_FACTOR,
 };
 
 /// Signed square root, `sign(e)·√|e|`: compresses the huge range of elevations (metres)

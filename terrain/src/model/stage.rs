@@ -1,9 +1,10 @@
 //! Learned stages as window functions of the infinite-tensor engine.
 //!
-//! [`LearnedStage`] runs a stage's model (coarse or core) on 64×64 windows (stride 32: ≈50 %
-//! overlap) of its own grid. Its conditioning is a field 8× coarser than that grid (the coarse stage, or the
-//! layout standing in for it), bilinearly upsampled from globally aligned cells so every
-//! window sees the same values where windows overlap. Its noise comes from
+//! [`LearnedStage`] runs a stage's model on 64×64 windows of its own grid (the manifest's
+//! stride: 32, ≈50 % overlap, unless it says otherwise). Its conditioning is a field
+//! `context.factor`× coarser than that grid (8× for the core: the coarse stage, or the layout
+//! standing in for it), bilinearly upsampled from globally aligned cells so every window sees
+//! the same values where windows overlap. Its noise comes from
 //! [`GaussianNoise`] keyed by (seed, stage, sampler step, global tile), so the result is a pure
 //! function of (seed, region). The whole few-step sampler runs inside each window (T = 1
 //! blending step); overlapping outputs are blended by the engine's tent weights.
@@ -14,7 +15,7 @@ use burn::tensor::{Device, Tensor, TensorData};
 
 use super::store::{LoadedModel, Normalisation};
 use super::{ReliefHint, Sampler, UNet};
-use crate::encoding::{blur, signed_sqrt, signed_square, BLUR_RADIUS, LAPLACIAN_FACTOR};
+use crate::encoding::{blur, signed_sqrt, signed_square, ContextSpec};
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::noise::{GaussianNoise, NoiseKey};
 use crate::tile::{Rect, Tile};
@@ -32,8 +33,9 @@ pub fn noise_stream(stage: &str) -> u32 {
 }
 
 /// A learned stage's model as a [`WindowFn`]: elevation in metres (one channel) on its grid,
-/// generated as the residual over a context 8× coarser (the context source gives plain box
-/// means or point values; the stage blurs them as training's Laplacian low band is blurred).
+/// generated as the residual over a context `context.factor`× coarser (the context source
+/// gives plain box means or point values; the stage blurs them when training's low band was
+/// blurred).
 pub struct LearnedStage {
     name: String,
     net: UNet,
@@ -41,6 +43,7 @@ pub struct LearnedStage {
     sampler: Sampler,
     norm: Normalisation,
     hint: Option<ReliefHint>,
+    spec: ContextSpec,
     coarse: Arc<dyn Source>,
     seed: u64,
     window: i64,
@@ -50,36 +53,39 @@ pub struct LearnedStage {
 
 impl LearnedStage {
     /// The stage `model.manifest.stage` of world `seed`: `model` on `device`, conditioned on
-    /// `coarse` (elevation in metres on a grid [`LAPLACIAN_FACTOR`]× coarser than the output),
-    /// windows of the model's size with half-window stride, `batch` windows per network call.
+    /// `coarse` (elevation in metres on a grid `context.factor`× coarser than the output),
+    /// windows of the model's size and stride, `batch` windows per network call.
     pub fn new(model: LoadedModel, device: Device, coarse: Arc<dyn Source>, seed: u64, batch: usize) -> LearnedStage {
         let window = model.manifest.window as i64;
+        let stride = model.manifest.window_stride() as i64;
         LearnedStage {
             name: model.manifest.stage.clone(),
             sampler: model.manifest.sampler.clone(),
             norm: model.manifest.normalisation.clone(),
             hint: model.manifest.relief_hint.clone(),
+            spec: model.manifest.context,
             net: model.net,
             device,
             coarse,
             seed,
             window,
-            stride: window / 2,
+            stride,
             batch: batch.max(1),
         }
     }
 
     /// The conditioning of one window, in the network's units, and the un-normalised
     /// signed-sqrt low band the output is added to. Built exactly like training's low band:
-    /// the coarse grid (box means) in signed sqrt, blurred, bilinearly upsampled — the blur
-    /// reads [`BLUR_RADIUS`] extra cells on each side, so neighbouring windows agree.
+    /// the coarse grid (box means) in signed sqrt, blurred if the stage's context is,
+    /// bilinearly upsampled — the blur reads `BLUR_RADIUS` extra cells on each side, so
+    /// neighbouring windows agree.
     pub(crate) fn context(&self, rect: Rect) -> (Vec<f32>, Vec<f32>) {
-        let f = LAPLACIAN_FACTOR as i64;
+        let f = self.spec.factor as i64;
         let src = upsample::source_rect(&rect, f);
-        let r = BLUR_RADIUS as i64;
+        let r = self.spec.margin() as i64;
         let padded = Rect::new(src.y0 - r, src.x0 - r, src.h + 2 * r, src.w + 2 * r);
         let h: Vec<f32> = self.coarse.query(padded).data.iter().map(|&e| signed_sqrt(e)).collect();
-        let blurred = blur(&h, padded.h as usize, padded.w as usize);
+        let blurred = if self.spec.blur { blur(&h, padded.h as usize, padded.w as usize) } else { h };
         let inner = (0..src.h)
             .flat_map(|y| {
                 let row = ((y + r) * padded.w + r) as usize;

@@ -18,6 +18,7 @@ use sha2::{Digest, Sha256};
 use super::hint::ReliefHint;
 use super::sampler::Sampler;
 use super::unet::{UNet, UNetConfig};
+use crate::encoding::ContextSpec;
 
 /// Version of the manifest layout; bumped on incompatible changes.
 const MANIFEST_VERSION: u32 = 1;
@@ -106,6 +107,14 @@ pub struct ModelManifest {
     pub metres_per_pixel: f64,
     /// Window side the model is meant to run on, pixels.
     pub window: usize,
+    /// Distance between neighbouring windows, pixels (0, as in older manifests: half the
+    /// window, i.e. 50 % overlap).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stride: usize,
+    /// How the stage's context is made from the grid above it (older manifests: the 8×
+    /// blurred Laplacian low band).
+    #[serde(default)]
+    pub context: ContextSpec,
     /// Value mapping.
     pub normalisation: Normalisation,
     /// Predicts the relief entry of the conditioning vector from the context; without it the
@@ -124,7 +133,20 @@ pub struct ModelManifest {
     pub recreate: String,
 }
 
+fn is_zero(v: &usize) -> bool {
+    *v == 0
+}
+
 impl ModelManifest {
+    /// Distance between neighbouring windows, pixels.
+    pub fn window_stride(&self) -> usize {
+        if self.stride == 0 {
+            self.window / 2
+        } else {
+            self.stride
+        }
+    }
+
     /// A manifest for `stage` with `architecture`; the weight fields are filled in by
     /// [`save_model`].
     pub fn new(stage: &str, architecture: UNetConfig, sampler: Sampler) -> ModelManifest {
@@ -140,6 +162,8 @@ impl ModelManifest {
             macs_per_pixel: 0.0,
             metres_per_pixel: 0.0,
             window: 64,
+            stride: 0,
+            context: ContextSpec::default(),
             normalisation: Normalisation::default(),
             relief_hint: None,
             sampler,
@@ -307,6 +331,16 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
     }
     if manifest.window < 8 || manifest.window % 8 != 0 {
         return Err(manifest_corrupt(format!("window = {} (must be a multiple of 8, at least 8)", manifest.window)));
+    }
+    if manifest.stride > manifest.window {
+        return Err(manifest_corrupt(format!("stride = {} exceeds window = {}", manifest.stride, manifest.window)));
+    }
+    manifest.context.validate().map_err(manifest_corrupt)?;
+    if manifest.window % manifest.context.factor != 0 {
+        return Err(manifest_corrupt(format!(
+            "window = {} is not a multiple of context.factor = {}",
+            manifest.window, manifest.context.factor
+        )));
     }
 
     let dir = manifest_path.parent().unwrap_or(Path::new("."));

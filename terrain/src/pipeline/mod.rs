@@ -12,7 +12,7 @@ use std::sync::Arc;
 pub use stages::{StageState, StageStatus};
 
 use crate::climate::{precipitation, temperature_at, Orographic};
-use crate::encoding::{box_downsample, LAPLACIAN_FACTOR};
+use crate::encoding::box_downsample;
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::settings::TerrainSettings;
@@ -81,8 +81,8 @@ pub enum PipelineError {
 }
 
 /// A grid `factor`× coarser than its source's, each cell the mean of its `factor`² source
-/// cells: the context a learned stage is conditioned on (with [`LAPLACIAN_FACTOR`], the box
-/// downsample of training's Laplacian low band; the stage applies the blur).
+/// cells: the context a learned stage is conditioned on (the box downsample of training's
+/// low band; the stage applies the blur).
 #[cfg_attr(not(feature = "learned"), allow(dead_code))]
 struct BoxMean {
     source: Arc<dyn Source>,
@@ -149,10 +149,11 @@ impl Pipeline {
         let coarse_metres = MODEL_PIXEL_METRES * COARSE_FACTOR as f64;
         let mut stages = stages::current();
         let sketch_elevation: Arc<dyn Source> = Arc::new(layout.elevation(coarse_metres));
-        let coarse_elevation: Arc<dyn Source> = if settings.engine.learned.iter().any(|s| s == "coarse") {
-            // The coarse model refines the layout from its 64 km means (its Laplacian context).
-            let context = Arc::new(BoxMean { source: sketch_elevation, factor: LAPLACIAN_FACTOR as i64 });
-            learned_stage("coarse", seed, settings, &engine, context, coarse_metres, &mut stages)?
+        let learned = |name: &str| settings.engine.learned.iter().any(|s| s == name);
+        let coarse_elevation: Arc<dyn Source> = if learned("coarse") {
+            // The coarse model refines the layout's sketch on the sketch's own 8 km grid.
+            let stage = learned_stage("coarse", seed, settings, &engine, sketch_elevation, coarse_metres, &mut stages)?;
+            stage.on_grid(coarse_metres)?
         } else {
             sketch_elevation
         };
@@ -169,8 +170,17 @@ impl Pipeline {
                 margin: 48,
             },
         );
-        let elevation: Arc<dyn Source> = if settings.engine.learned.iter().any(|s| s == "core") {
-            learned_stage("core", seed, settings, &engine, coarse_elevation.clone(), MODEL_PIXEL_METRES, &mut stages)?
+        let elevation: Arc<dyn Source> = if learned("core") {
+            let core =
+                learned_stage("core", seed, settings, &engine, coarse_elevation.clone(), coarse_metres, &mut stages)?;
+            if learned("detail") {
+                // The detail model adds the high-frequency residual over the core's own grid.
+                let (context, metres) = (core.source, core.metres);
+                learned_stage("detail", seed, settings, &engine, context, metres, &mut stages)?
+                    .on_grid(MODEL_PIXEL_METRES)?
+            } else {
+                core.on_grid(MODEL_PIXEL_METRES)?
+            }
         } else if settings.engine.learned.is_empty() {
             Arc::new(layout.elevation(MODEL_PIXEL_METRES))
         } else {
@@ -289,9 +299,43 @@ impl Pipeline {
     }
 }
 
+/// A learned stage's output on its own grid.
+#[cfg_attr(not(feature = "learned"), allow(dead_code))]
+struct StageGrid {
+    /// The stage's window function behind the engine's cache.
+    source: Arc<dyn Source>,
+    /// Real size of one of its pixels, metres.
+    metres: f64,
+    /// Its manifest (for errors).
+    file: String,
+    /// Its name.
+    name: String,
+}
+
+impl StageGrid {
+    /// The stage brought to a grid of `target` metres by exact bilinear upsampling (its own
+    /// grid must be a whole multiple of the target's).
+    fn on_grid(self, target: f64) -> Result<Arc<dyn Source>, PipelineError> {
+        let factor = self.metres / target;
+        if factor < 1.0 || (factor - factor.round()).abs() > 1e-6 {
+            return Err(PipelineError::Resolution {
+                file: self.file,
+                stage: self.name,
+                found: self.metres,
+                needed: format!("a whole multiple of {target} m per pixel"),
+            });
+        }
+        Ok(if factor.round() as i64 == 1 {
+            self.source
+        } else {
+            Arc::new(Upsampled { source: self.source, factor: factor.round() as i64 })
+        })
+    }
+}
+
 /// The learned stage `name` (`models/<name>.json`), conditioned on `context` (metres on a grid
-/// [`LAPLACIAN_FACTOR`]× coarser than the model's), brought to a grid of `target_metres` by
-/// exact bilinear upsampling when the model's is coarser. Marks the stage active.
+/// of `context_metres`; box-averaged further when the model's context, `context.factor` of
+/// its own pixels, is coarser than that). Marks the stage active.
 #[cfg(feature = "learned")]
 fn learned_stage(
     name: &str,
@@ -299,35 +343,36 @@ fn learned_stage(
     settings: &TerrainSettings,
     engine: &Arc<Engine>,
     context: Arc<dyn Source>,
-    target_metres: f64,
+    context_metres: f64,
     stages: &mut [StageStatus],
-) -> Result<Arc<dyn Source>, PipelineError> {
+) -> Result<StageGrid, PipelineError> {
     use crate::model::{load_model, stage::LearnedStage, ComputeBackend};
     let backend: ComputeBackend = settings.engine.backend.parse()?;
     let device = backend.device()?;
     let model = load_model(&settings.engine.models, name, &device)?;
+    let file = settings.engine.models.join(format!("{name}.json")).display().to_string();
     let metres = model.manifest.metres_per_pixel;
-    let factor = (metres / target_metres).round();
-    // The core conditions on the 8 km grid (so it is trained at 1 km); the coarse model is the
-    // 8 km grid itself.
-    let needed = if name == "coarse" {
-        target_metres
-    } else {
-        MODEL_PIXEL_METRES * COARSE_FACTOR as f64 / LAPLACIAN_FACTOR as f64
-    };
-    if factor < 1.0 || (metres - needed).abs() > 1e-6 * needed {
+    let cell = metres * model.manifest.context.factor as f64;
+    let ratio = cell / context_metres;
+    if ratio < 1.0 - 1e-6 || (ratio - ratio.round()).abs() > 1e-6 {
         return Err(PipelineError::Resolution {
-            file: settings.engine.models.join(format!("{name}.json")).display().to_string(),
+            file,
             stage: name.to_string(),
             found: metres,
-            needed: format!("{needed} m per pixel"),
+            needed: format!(
+                "context.factor × metres_per_pixel = {cell} m, a whole multiple of the {context_metres} m grid above it"
+            ),
         });
     }
-    let stage = Windowed::new(engine, LearnedStage::new(model, device, context, seed, 8));
+    let context: Arc<dyn Source> = match ratio.round() as i64 {
+        1 => context,
+        factor => Arc::new(BoxMean { source: context, factor }),
+    };
+    let source = Windowed::new(engine, LearnedStage::new(model, device, context, seed, 8));
     for s in stages.iter_mut().filter(|s| s.name == name) {
         s.state = StageState::Active;
     }
-    Ok(if factor as i64 == 1 { stage } else { Arc::new(Upsampled { source: stage, factor: factor as i64 }) })
+    Ok(StageGrid { source, metres, file, name: name.to_string() })
 }
 
 #[cfg(not(feature = "learned"))]
@@ -337,9 +382,9 @@ fn learned_stage(
     settings: &TerrainSettings,
     _engine: &Arc<Engine>,
     _context: Arc<dyn Source>,
-    _target_metres: f64,
+    _context_metres: f64,
     _stages: &mut [StageStatus],
-) -> Result<Arc<dyn Source>, PipelineError> {
+) -> Result<StageGrid, PipelineError> {
     Err(PipelineError::NotBuilt(settings.engine.learned.clone()))
 }
 

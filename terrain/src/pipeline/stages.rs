@@ -28,7 +28,7 @@ pub fn current() -> Vec<StageStatus> {
     // Stages a configuration can turn on (`engine.learned`) start as off; the pipeline marks
     // the ones it loads as active.
     const OFF: &str = "off (not in engine.learned): the layout stands in";
-    const UNTRAINED: &str = "not trainable yet (issue #4): bilinear upsampling stands in";
+    const UPSAMPLED: &str = "off (not in engine.learned): the core's relief is bilinearly upsampled";
     vec![
         StageStatus {
             name: "layout",
@@ -48,7 +48,7 @@ pub fn current() -> Vec<StageStatus> {
         StageStatus {
             name: "detail",
             role: "high-frequency residual",
-            state: StageState::Missing { reason: UNTRAINED },
+            state: StageState::Missing { reason: UPSAMPLED },
         },
         StageStatus {
             name: "climate",

@@ -171,11 +171,12 @@ mod learned {
     use super::*;
     use crate::model::{save_model, ModelManifest, Normalisation, Precision, Sampler, SamplerKind, UNet, UNetConfig};
 
-    /// Tiny untrained models of the core (1 km) and coarse (`coarse_metres`) stages.
+    /// Tiny untrained models of the core (1 km), coarse (`coarse_metres`) and detail (500 m,
+    /// 2× unblurred context, 75 % overlap) stages.
     fn models_dir(name: &str, coarse_metres: f64) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("infiniterra-pipeline-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        for (stage, metres, seed) in [("core", 1000.0, 3), ("coarse", coarse_metres, 4)] {
+        for (stage, metres, seed) in [("core", 1000.0, 3), ("coarse", coarse_metres, 4), ("detail", 500.0, 5)] {
             let mut net = UNet::new(&UNetConfig::tiny(), seed, &burn::tensor::Device::flex());
             // A non-zero output gain, so the untrained network changes what it is given.
             net.out_gain = net.out_gain.map(|g| g.add_scalar(0.5));
@@ -183,6 +184,10 @@ mod learned {
                 ModelManifest::new(stage, net.config.clone(), Sampler::karras(SamplerKind::Euler, 2, 0.05, 40.0, 7.0));
             manifest.window = 32;
             manifest.metres_per_pixel = metres;
+            if stage == "detail" {
+                manifest.context = crate::encoding::ContextSpec { factor: 2, blur: false };
+                manifest.stride = 8;
+            }
             manifest.normalisation = Normalisation {
                 target_scale: 4.0,
                 cond_mean: 10.0,
@@ -259,6 +264,37 @@ mod learned {
             both.columns(whole).channel(channel::ELEVATION),
             core_only.columns(whole).channel(channel::ELEVATION)
         );
+        let _ = std::fs::remove_dir_all(&models);
+    }
+
+    #[test]
+    fn with_core_and_detail_a_region_is_bit_identical_and_the_detail_model_shapes_it() {
+        let models = models_dir("detail", 8000.0);
+        let whole = Rect::new(9_000, -31_000, 48, 48);
+        let both = learned_stages(4, &models, 256, 1, &["core", "detail"]);
+        assert!(both.active_stages().contains(&"detail".to_string()), "{:?}", both.active_stages());
+        let reference = both.columns(whole);
+        assert!(reference.data.iter().all(|v| v.is_finite()));
+        for (cache_mib, threads, order) in [(256, 2, 5), (1, 2, 6)] {
+            let p = learned_stages(4, &models, cache_mib, threads, &["core", "detail"]);
+            let chunks: Vec<Rect> =
+                (0..9).map(|i| Rect::new(whole.y0 + (i / 3) * 16, whole.x0 + (i % 3) * 16, 16, 16)).collect();
+            for r in shuffled(chunks, order) {
+                assert!(
+                    p.columns(r) == reference.crop(r),
+                    "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)"
+                );
+            }
+        }
+        // The detail model replaces the core's bilinear upsampling.
+        let core_only = learned(4, &models, 256, 1).columns(whole);
+        let (d, c) = (reference.channel(channel::ELEVATION), core_only.channel(channel::ELEVATION));
+        assert_ne!(d, c);
+        // Detail without the core is refused by the settings.
+        let mut settings = TerrainSettings::default();
+        settings.engine.learned = vec!["detail".into()];
+        let err = settings.engine.validate().expect_err("detail needs core").to_string();
+        assert!(err.contains("engine.learned") && err.contains("core"), "{err}");
         let _ = std::fs::remove_dir_all(&models);
     }
 
