@@ -38,9 +38,31 @@ pub enum Pre<'a> {
 /// (CPU) tensors. An autodiff tensor — or an untracked input meeting tracked weights, as in
 /// training — keeps burn's kernels, which record the graph.
 pub fn applies(x: &Tensor<4>, weight: &Tensor<4>) -> bool {
-    let plain =
-        |t: &Tensor<4>| !t.is_autodiff() && t.device() == Device::flex() && t.dtype() == burn::tensor::DType::F32;
     plain(x) && plain(weight)
+}
+
+/// Whether a tensor is a plain (not autodiff) f32 tensor on burn's flex CPU backend, whose
+/// values this module may compute on the host.
+pub fn plain<const D: usize>(t: &Tensor<D>) -> bool {
+    !t.is_autodiff() && t.device() == Device::flex() && t.dtype() == burn::tensor::DType::F32
+}
+
+/// `x · wᵀ` for plain tensors `x` (`[b, in]`) and `w` (`[out, in]`), every output a dot
+/// product summed in the same order whatever the batch: burn's matmul picks its kernel by
+/// shape, so the same row could come out a rounding step apart in a batch of 1 and one of 8 —
+/// and the engine batches windows differently depending on what a query finds cached.
+pub fn linear(x: Tensor<2>, w: Tensor<2>) -> Tensor<2> {
+    let device = x.device();
+    let [b, cin] = x.dims();
+    let [cout, win] = w.dims();
+    assert_eq!(cin, win, "linear: {cin} inputs for a [{cout}, {win}] weight");
+    let x: Vec<f32> = x.into_data().try_into_vec().expect("linear: f32 input");
+    let w: Vec<f32> = w.into_data().try_into_vec().expect("linear: f32 weight");
+    let out: Vec<f32> = x
+        .chunks(cin)
+        .flat_map(|row| w.chunks(cin).map(move |col| row.iter().zip(col).fold(0.0f32, |acc, (a, b)| acc + a * b)))
+        .collect();
+    Tensor::from_data(TensorData::new(out, [b, cout]), &device)
 }
 
 /// `conv2d(pre(x), weight)` with "same" zero padding, stride 1, no bias, for a plain flex

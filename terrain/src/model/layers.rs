@@ -153,12 +153,21 @@ impl MpLinear {
 
     /// `x · Wᵀ` for `x` of shape `[batch, in]`.
     pub fn forward(&self, x: Tensor<2>) -> Tensor<2> {
-        x.matmul(self.matrix().transpose())
+        Self::apply(x, self.matrix())
     }
 
     /// `x · Wᵀ · gain` with a learned scalar gain (shape `[1]`).
     pub fn forward_gain(&self, x: Tensor<2>, gain: Tensor<1>) -> Tensor<2> {
-        x.matmul((self.matrix() * gain.reshape([1, 1])).transpose())
+        Self::apply(x, self.matrix() * gain.reshape([1, 1]))
+    }
+
+    /// `x · wᵀ`; at inference on the CPU row by row, so a sample's result does not depend on
+    /// the batch it is in (see [`cpu_conv::linear`]).
+    fn apply(x: Tensor<2>, w: Tensor<2>) -> Tensor<2> {
+        if cpu_conv::plain(&x) && cpu_conv::plain(&w) {
+            return cpu_conv::linear(x, w);
+        }
+        x.matmul(w.transpose())
     }
 }
 
