@@ -21,8 +21,11 @@ use super::heldout::counterpart;
 use crate::eval::{realism_bar, Target};
 use crate::terrain::metrics::Raster;
 
-/// Offsets tried first (z units); the best is then refined by ±[`REFINE`].
-const GRID: [f64; 7] = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0, 1.2];
+/// Offsets tried first (z units): 0, 0.2, … up to [`GRID_MAX`], until the score has risen
+/// twice in a row; the best is then refined by ±[`REFINE`].
+const GRID_STEP: f64 = 0.2;
+/// The largest offset the sweep tries (3 z units: far beyond any roughness in the data).
+const GRID_MAX: f64 = 3.0;
 /// Refinement step around the best grid offset.
 const REFINE: f64 = 0.1;
 
@@ -117,7 +120,8 @@ pub fn run(
         tried.push((offset, s));
         s
     };
-    for &offset in &GRID {
+    let steps = (GRID_MAX / GRID_STEP).round() as usize;
+    for offset in (0..=steps).map(|i| i as f64 * GRID_STEP) {
         evaluate(offset, &mut tried);
         // The score is unimodal in practice: two rises in a row past the best end the sweep.
         if let [.., a, b, c] = tried.as_slice() {
