@@ -157,13 +157,15 @@ fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, Failure> {
             context: ContextSpec::default(),
             stride: 0,
         }),
-        // The same network one level up: 8 km relief (continents, shelves, basins) from the
-        // 64 km means of the layout.
+        // The same network one level up: 8 km relief (continents, shelves, basins) refining
+        // the layout's sketch from its blurred 16 km means. (The first coarse weights used
+        // 64 km means, as the core does one level down, and flattened the layout's narrower
+        // ranges: a 3,000 m range came out as 1,000 m blobs.)
         "coarse" => Ok(StageSpec {
             metres_per_pixel: 8000.0,
             config: pick(UNetConfig::core()),
             sampler: Sampler::few_step(),
-            context: ContextSpec::default(),
+            context: ContextSpec { factor: 2, blur: true },
             stride: 0,
         }),
         // The last stage: 500 m relief over the core's own 1 km grid, unblurred (the core's
