@@ -53,8 +53,12 @@ fn an_empty_file_means_every_default() {
 
 #[test]
 fn learned_stage_names_and_backends_are_checked() {
-    let err = parse("[engine]\nlearned = [\"core\", \"detail\"]\n").unwrap_err().to_string();
-    assert!(err.starts_with("config/test.toml:2: engine.learned = \"detail\"") && err.contains("core"), "{err}");
+    let err = parse("[engine]\nlearned = [\"core\", \"canyon\"]\n").unwrap_err().to_string();
+    assert!(err.starts_with("config/test.toml:2: engine.learned = \"canyon\"") && err.contains("detail"), "{err}");
+    let err = parse("[engine]\nlearned = [\"detail\"]\n").unwrap_err().to_string();
+    assert!(err.starts_with("config/test.toml:2: engine.learned") && err.contains("together with \"core\""), "{err}");
+    let both = parse("[engine]\nlearned = [\"core\", \"detail\"]\n").unwrap().engine.learned;
+    assert_eq!(both, vec!["core".to_string(), "detail".to_string()]);
     let err = parse("[engine]\nbackend = \"cuda\"\n").unwrap_err().to_string();
     assert!(err.contains("engine.backend = \"cuda\"") && err.contains("\"wgpu\""), "{err}");
     assert_eq!(parse("[engine]\nlearned = [\"core\"]\n").unwrap().engine.learned, vec!["core".to_string()]);
