@@ -25,9 +25,9 @@ use crate::terrain::metrics::Raster;
 /// twice in a row; the best is then refined by ±[`REFINE`].
 const GRID_STEP: f64 = 0.2;
 /// The largest offset the sweep tries (3 z units: far beyond any roughness in the data).
-const GRID_MAX: f64 = 3.0;
+pub(super) const GRID_MAX: f64 = 3.0;
 /// Refinement step around the best grid offset.
-const REFINE: f64 = 0.1;
+pub(super) const REFINE: f64 = 0.1;
 
 /// How far a generated set is from the bar, averaged over its metrics: each distance in
 /// units of the bar's fBm line (distance / (fBm's distance / 5): 1 on the line), the
