@@ -320,10 +320,8 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
 /// A training run in progress.
 pub struct Trainer {
     args: TrainArgs,
-    spec_metres: f64,
-    sampler: Sampler,
-    context: ContextSpec,
-    stride: usize,
+    /// The stage's resolution, sampler, context and stride (what `ship` writes).
+    spec: StageSpec,
     device: Device,
     plain: Device,
     net: UNet,
@@ -431,23 +429,8 @@ impl Trainer {
             };
             (net, ema, optim, state)
         };
-        let mut t = Trainer {
-            args: args.clone(),
-            spec_metres: spec.metres_per_pixel,
-            sampler: spec.sampler,
-            context: spec.context,
-            stride: spec.stride,
-            device,
-            plain,
-            net,
-            ema,
-            optim,
-            state,
-            train,
-            heldout,
-            noise,
-            paths,
-        };
+        let mut t =
+            Trainer { args: args.clone(), spec, device, plain, net, ema, optim, state, train, heldout, noise, paths };
         // A resumed run keeps its batch, crop and schedule: they define which samples each
         // step sees, and changing them would silently make it a different run.
         t.args.batch = t.state.batch;
@@ -617,11 +600,11 @@ impl Trainer {
 
     /// Writes the EMA weights and manifest to `<out>/<stage>.*`.
     fn ship(&self) -> anyhow::Result<()> {
-        let mut manifest = ModelManifest::new(&self.args.stage, self.state.config.clone(), self.sampler.clone());
-        manifest.metres_per_pixel = self.spec_metres;
+        let mut manifest = ModelManifest::new(&self.args.stage, self.state.config.clone(), self.spec.sampler.clone());
+        manifest.metres_per_pixel = self.spec.metres_per_pixel;
         manifest.window = 64;
-        manifest.stride = self.stride;
-        manifest.context = self.context;
+        manifest.stride = self.spec.stride;
+        manifest.context = self.spec.context;
         manifest.normalisation = self.state.normalisation.clone();
         manifest.relief_hint = self.train.relief_hint(self.state.crop, &self.state.normalisation);
         manifest.training = TrainingRecord {
