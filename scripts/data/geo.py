@@ -76,17 +76,22 @@ def tile_coords(lat_c, lon_c, size, metres):
 def tile_centres(lat_top, lat_bottom, lon_west, lon_east, size, metres, overlap=1):
     """Tile centres covering a lat/lon box row by row from the north, `overlap` tiles per
     tile side (1 = edge to edge, 2 = half-tile stride). In a row, tiles are spaced by their
-    width at the poleward edge, the widest, so neighbours never overlap unless asked."""
+    width at the poleward edge, the widest, so neighbours never overlap unless asked.
+    Returns (lat, lon, row, column) per tile, row 0 north, column 0 west."""
     extent = size * metres
     dlat = math.degrees(extent / EARTH_RADIUS_M)
     centres = []
     lat_c = lat_top - dlat / 2
+    row = 0
     while lat_c - dlat / 2 >= lat_bottom:
         poleward = min(abs(lat_c) + dlat / 2, 89.0)
         dlon = math.degrees(extent / (EARTH_RADIUS_M * math.cos(math.radians(poleward))))
         lon_c = lon_west + dlon / 2
+        col = 0
         while lon_c + dlon / 2 <= lon_east:
-            centres.append((lat_c, lon_c))
+            centres.append((lat_c, lon_c, row, col))
             lon_c += dlon / overlap
+            col += 1
         lat_c -= dlat / overlap
+        row += 1
     return centres

@@ -102,7 +102,18 @@ mod tests {
     /// where it does not.
     #[test]
     fn fetch_script_self_test_passes() {
-        let Ok(script) = locate("fetch.py") else { panic!("fetch.py is missing") };
+        script_self_test_passes("fetch.py");
+    }
+
+    /// The held-out split rules of `prepare.py` (a quarter of the core's squares, none
+    /// touching another; the bands of the other stages, across the 0°/360° seam).
+    #[test]
+    fn prepare_script_self_test_passes() {
+        script_self_test_passes("prepare.py");
+    }
+
+    fn script_self_test_passes(name: &str) {
+        let Ok(script) = locate(name) else { panic!("{name} is missing") };
         match Command::new("python3").arg(script).arg("--self-test").output() {
             Ok(out) => assert!(
                 out.status.success(),
@@ -110,7 +121,7 @@ mod tests {
                 String::from_utf8_lossy(&out.stdout),
                 String::from_utf8_lossy(&out.stderr)
             ),
-            Err(e) => eprintln!("python3 not available ({e}); fetch self-test skipped"),
+            Err(e) => eprintln!("python3 not available ({e}); {name} self-test skipped"),
         }
     }
 
