@@ -112,7 +112,7 @@ mod tests {
         script_self_test_passes("prepare.py");
     }
 
-    fn script_self_test_passes(name: &str) {
+    fn script_self_test_passes(name: &'static str) {
         let Ok(script) = locate(name) else { panic!("{name} is missing") };
         match Command::new("python3").arg(script).arg("--self-test").output() {
             Ok(out) => assert!(
