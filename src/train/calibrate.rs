@@ -21,8 +21,8 @@ use super::heldout::counterpart;
 use crate::eval::{realism_bar, Target};
 use crate::terrain::metrics::Raster;
 
-/// Offsets tried first (z units): 0, 0.2, … up to [`GRID_MAX`], until the score has risen
-/// twice in a row; the best is then refined by ±[`REFINE`].
+/// Offsets tried first (z units): 0, 0.2, … up to [`GRID_MAX`], until two in a row fall
+/// short of the best so far (see [`Trial::beats`]); the best is then refined by ±[`REFINE`].
 const GRID_STEP: f64 = 0.2;
 /// The largest offset the sweep tries (3 z units: far beyond any roughness in the data).
 pub(super) const GRID_MAX: f64 = 3.0;
@@ -49,6 +49,31 @@ pub fn score(targets: &[Target]) -> f64 {
         return f64::INFINITY;
     }
     parts.iter().sum::<f64>() / parts.len() as f64
+}
+
+/// One offset's result on the calibration tiles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Trial {
+    /// The hint offset tried.
+    pub offset: f64,
+    /// Lines of the realism bar met.
+    pub met: usize,
+    /// [`score`] of the set.
+    pub score: f64,
+}
+
+impl Trial {
+    /// The bar's own judgement first — more of its lines met — then the nearer [`score`].
+    /// The score alone averages ratios, so one metric far off (closed depressions, say) can
+    /// outweigh three that moved onto their lines.
+    pub fn beats(&self, other: &Trial) -> bool {
+        self.met > other.met || (self.met == other.met && self.score < other.score)
+    }
+}
+
+/// The best of `tried` by [`Trial::beats`] (the earliest among equals).
+pub(super) fn best(tried: &[Trial]) -> Option<Trial> {
+    tried.iter().copied().reduce(|best, t| if t.beats(&best) { t } else { best })
 }
 
 /// `count` tiles spread evenly over `tiles`, starting at `phase` of the spacing (0 or ½), so
@@ -97,8 +122,8 @@ pub fn run(
     let seam_stride = model.manifest.window_stride();
 
     let started = Instant::now();
-    let mut tried: Vec<(f64, f64)> = Vec::new();
-    let mut evaluate = |offset: f64, tried: &mut Vec<(f64, f64)>| {
+    let mut tried: Vec<Trial> = Vec::new();
+    let mut evaluate = |offset: f64, tried: &mut Vec<Trial>| {
         if let Some(hint) = model.manifest.relief_hint.as_mut() {
             hint.offset = offset;
         }
@@ -117,27 +142,35 @@ pub fn run(
             "calibrate {stage}: offset {offset:+.2} → score {s:.3} ({met}/{} met on {count} training tiles; {elapsed:.0} s)",
             targets.len()
         );
-        tried.push((offset, s));
-        s
+        tried.push(Trial { offset, met, score: s });
     };
     let steps = (GRID_MAX / GRID_STEP).round() as usize;
+    let mut short = 0;
     for offset in (0..=steps).map(|i| i as f64 * GRID_STEP) {
+        let before = best(&tried);
         evaluate(offset, &mut tried);
-        // The score is unimodal in practice: two rises in a row past the best end the sweep.
-        if let [.., a, b, c] = tried.as_slice() {
-            if a.1 < b.1 && b.1 < c.1 {
-                break;
-            }
+        let latest = *tried.last().expect("just tried");
+        short = if before.is_some_and(|b| !latest.beats(&b)) { short + 1 } else { 0 };
+        if short == 2 {
+            break;
         }
     }
-    let best_grid = tried.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).map_or(0.0, |(o, _)| o);
+    let best_grid = best(&tried).map_or(0.0, |t| t.offset);
     for offset in [best_grid - REFINE, best_grid + REFINE] {
         if offset >= 0.0 {
             evaluate(offset, &mut tried);
         }
     }
-    let (best, best_score) = tried.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).expect("offsets were tried");
-    println!("relief hint of {}: offset {best:+.2} (score {best_score:.3}; tried {tried:?})", path.display());
+    let chosen = best(&tried).expect("offsets were tried");
+    let best = chosen.offset;
+    let summary: Vec<String> = tried.iter().map(|t| format!("{:+.2}: {}/7, {:.3}", t.offset, t.met, t.score)).collect();
+    println!(
+        "relief hint of {}: offset {best:+.2} ({}/7 met, score {:.3}; tried {})",
+        path.display(),
+        chosen.met,
+        chosen.score,
+        summary.join("; ")
+    );
 
     crate::manifest_edit::edit_manifest(&path, |object| {
         let hint = object
@@ -177,5 +210,17 @@ mod tests {
         assert!((score(&tiny_floor) - 0.5).abs() < 1e-12);
         let broken = [target("slope_w1_deg", f64::NAN, 0.0, 0.2, Some(1.0))];
         assert_eq!(score(&broken), f64::INFINITY);
+    }
+
+    #[test]
+    fn more_lines_met_beat_a_nearer_score_and_equals_keep_the_first() {
+        let t = |offset, met, score| Trial { offset, met, score };
+        // 0.6 meets four lines with one metric far off; 0.2 is nearer on average with two.
+        let tried = [t(0.0, 2, 5.2), t(0.2, 2, 3.3), t(0.4, 2, 4.3), t(0.6, 4, 5.4)];
+        assert_eq!(best(&tried).unwrap().offset, 0.6);
+        // Among equal counts the lower score wins, and an exact tie keeps the earlier offset.
+        assert_eq!(best(&tried[..3]).unwrap().offset, 0.2);
+        assert_eq!(best(&[t(0.2, 3, 1.0), t(0.4, 3, 1.0)]).unwrap().offset, 0.2);
+        assert_eq!(best(&[]), None);
     }
 }
