@@ -163,9 +163,10 @@ pub fn run(
     }
     let chosen = best(&tried).expect("offsets were tried");
     let best = chosen.offset;
-    let summary: Vec<String> = tried.iter().map(|t| format!("{:+.2}: {}/7, {:.3}", t.offset, t.met, t.score)).collect();
+    let summary: Vec<String> =
+        tried.iter().map(|t| format!("{:+.2}: {} met, {:.3}", t.offset, t.met, t.score)).collect();
     println!(
-        "relief hint of {}: offset {best:+.2} ({}/7 met, score {:.3}; tried {})",
+        "relief hint of {}: offset {best:+.2} ({} lines met, score {:.3}; tried {})",
         path.display(),
         chosen.met,
         chosen.score,
