@@ -116,6 +116,11 @@ pub struct TrainArgs {
     /// the realism bar (minutes), and write it into that manifest.
     #[arg(long)]
     pub calibrate_relief_hint: bool,
+    /// Train the stage's network at half the width (≈ ¼ of its cost per pixel). Trained
+    /// briefly into its own `--out`, it is the shipped model's autoguidance guide: a "bad
+    /// version of itself" whose errors guidance steers away from (`guide` in the manifest).
+    #[arg(long)]
+    pub half_width: bool,
     /// Use a very small network and no data files (smoke tests of the training machinery).
     #[arg(long, hide = true)]
     pub smoke: bool,
@@ -263,7 +268,10 @@ impl CheckpointPaths {
 
 /// Runs `infiniterra train`.
 pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
-    let spec = stage_spec(&args.stage, args.smoke)?;
+    let mut spec = stage_spec(&args.stage, args.smoke)?;
+    if args.half_width {
+        spec.config = spec.config.halved();
+    }
     if let Some(real) = &args.counterpart {
         return heldout::compare(
             &args.out,
@@ -635,8 +643,10 @@ impl Trainer {
         // machine-dependent step; this names the step it reached).
         let s = &self.state;
         let this_run = format!(
-            "infiniterra train {}{} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {} --precision {}",
+            "infiniterra train {}{}{} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {} --precision {}",
             s.stage,
+            // A guide is the half-width network in its own folder (`models/guide/`).
+            if self.args.half_width { format!(" --half-width --out {}", self.args.out.display()) } else { String::new() },
             s.continues.as_ref().map_or(String::new(), |(_, from)| format!(" --init-from {}", from.display())),
             s.step,
             s.seed,

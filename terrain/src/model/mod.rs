@@ -33,9 +33,9 @@ pub use edm::{edm_loss, NoiseDistribution};
 pub use hint::ReliefHint;
 pub use layers::{force_normalize, mp_cat, mp_silu, mp_sum, normalize_rows, pixel_norm, MpConv, MpLinear};
 pub use rng::HostRng;
-pub use sampler::{Sampler, SamplerKind};
+pub use sampler::{Guide, Sampler, SamplerKind};
 pub use store::{
-    load_model, load_model_file, save_model, sha256_file, sha256_hex, DataChecksum, LoadedModel, ModelError,
+    load_model, load_model_file, save_model, sha256_file, sha256_hex, DataChecksum, Guidance, LoadedModel, ModelError,
     ModelManifest, Normalisation, Precision, TrainingRecord,
 };
 pub use unet::{UNet, UNetConfig};

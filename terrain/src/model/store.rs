@@ -58,6 +58,17 @@ pub struct DataChecksum {
     pub sha256: String,
 }
 
+/// How a stage is autoguided (see [`Guide`](super::Guide)).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Guidance {
+    /// The guide's own manifest, relative to this manifest's folder (e.g. `core_guide.json`).
+    pub guide: String,
+    /// Guidance weight `w` (1: the main model alone; the paper's best are 1.5–3).
+    pub weight: f32,
+    /// How many of the sampler's first steps are guided (each costs the guide's network call).
+    pub steps: usize,
+}
+
 /// What training produced the weights.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct TrainingRecord {
@@ -123,6 +134,9 @@ pub struct ModelManifest {
     pub relief_hint: Option<ReliefHint>,
     /// The sampler to run it with.
     pub sampler: Sampler,
+    /// Autoguidance by a weaker model of the same stage (none: the model runs alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guidance: Option<Guidance>,
     /// How it was trained.
     pub training: TrainingRecord,
     /// What it was trained on.
@@ -167,6 +181,7 @@ impl ModelManifest {
             normalisation: Normalisation::default(),
             relief_hint: None,
             sampler,
+            guidance: None,
             training: TrainingRecord::default(),
             data: Vec::new(),
             realism: BTreeMap::new(),
@@ -213,6 +228,8 @@ pub struct LoadedModel {
     pub net: UNet,
     /// Its manifest.
     pub manifest: ModelManifest,
+    /// The autoguidance guide's network, when the manifest names one.
+    pub guide: Option<UNet>,
 }
 
 /// SHA-256 of bytes, lowercase hex.
@@ -374,5 +391,42 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
             result.errors
         )));
     }
-    Ok(LoadedModel { net, manifest })
+    let guide = match &manifest.guidance {
+        None => None,
+        // The guide's own errors name its files and the command that recreates it.
+        Some(g) => Some(load_guide(dir, g, &manifest, device)?),
+    };
+    Ok(LoadedModel { net, manifest, guide })
+}
+
+/// Loads the guide a manifest's `guidance` names and checks it can guide `main`: the same
+/// normalisation and conditioning (both networks see the same inputs), no guide of its own.
+fn load_guide(dir: &Path, g: &Guidance, main: &ModelManifest, device: &Device) -> Result<UNet, ModelError> {
+    let path = dir.join(&g.guide);
+    let corrupt = |reason: String| ModelError::Corrupt { path: path.clone(), reason, command: main.recreate.clone() };
+    if !(g.weight.is_finite() && (0.0..=10.0).contains(&g.weight)) || g.steps == 0 {
+        return Err(corrupt(format!(
+            "guidance weight {} / steps {} (the weight must be in 0..=10, steps at least 1)",
+            g.weight, g.steps
+        )));
+    }
+    let guide = load_model_file(&path, device)?;
+    let (a, b) = (&guide.manifest, main);
+    if a.guidance.is_some() {
+        return Err(corrupt("a guide cannot have a guide of its own".into()));
+    }
+    if a.normalisation != b.normalisation
+        || a.context != b.context
+        || a.window != b.window
+        || a.architecture.channels_cond != b.architecture.channels_cond
+        || a.architecture.vector_dim != b.architecture.vector_dim
+        || a.architecture.channels_out != b.architecture.channels_out
+        || a.architecture.sigma_data != b.architecture.sigma_data
+    {
+        return Err(corrupt(format!(
+            "its inputs differ from {}'s (normalisation, context, window or conditioning channels)",
+            b.stage
+        )));
+    }
+    Ok(guide.net)
 }

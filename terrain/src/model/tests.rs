@@ -195,6 +195,53 @@ fn dpm_solver_is_more_accurate_than_euler_at_equal_steps() {
     assert!(dpm < euler / 3.0, "relative error: DPM-Solver++(2M) {dpm:.4}, Euler {euler:.4}");
 }
 
+#[test]
+fn autoguidance_interpolates_from_the_guide_to_the_model_and_beyond() {
+    let (net, weak) = (perturbed_tiny(4), perturbed_tiny(8));
+    let (noise, cond, vector) = fixed_inputs(2);
+    let sampler = Sampler::karras(SamplerKind::DpmPp2m, 3, 0.05, 10.0, 7.0);
+    let run = |weight: f32, steps: usize| {
+        let guide = Guide { net: &weak, weight, steps };
+        values(sampler.sample_guided(&net, Some(&guide), &noise, Some(cond.clone()), Some(vector.clone())))
+    };
+    let plain = values(sampler.sample(&net, &noise, Some(cond.clone()), Some(vector.clone())));
+    let weak_alone = values(sampler.sample(&weak, &noise, Some(cond.clone()), Some(vector.clone())));
+    // w = 0 is the guide exactly; w = 1 the model (to rounding: D_g + (D − D_g)).
+    assert_eq!(run(0.0, 3), weak_alone);
+    let gap = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(p, q)| (p - q).abs()).fold(0.0f32, f32::max);
+    assert!(gap(&run(1.0, 3), &plain) < 1e-5, "w = 1 moved the sample by {}", gap(&run(1.0, 3), &plain));
+    // w = 2 extrapolates past the model, away from the guide; guiding fewer steps moves less.
+    let (two, two_first) = (run(2.0, 3), run(2.0, 1));
+    let spread = gap(&plain, &weak_alone);
+    assert!(spread > 1e-3, "the two networks differ");
+    assert!(gap(&two, &plain) > 0.1 * spread && gap(&two_first, &plain) > 0.0);
+    assert!(gap(&two_first, &plain) < gap(&two, &plain));
+}
+
+#[test]
+fn a_guided_model_loads_its_guide_and_refuses_one_that_sees_other_inputs() {
+    let dir = tempdir("guided");
+    let (net, weak) = (perturbed_tiny(6), UNet::new(&UNetConfig::tiny().halved(), 7, &device()));
+    save_model(&dir.join("guide"), &weak, manifest_for(&weak), Precision::F32).expect("save guide");
+    let mut manifest = manifest_for(&net);
+    manifest.guidance = Some(Guidance { guide: "guide/test.json".into(), weight: 2.0, steps: 2 });
+    save_model(&dir, &net, manifest, Precision::F32).expect("save model");
+    let loaded = load_model(&dir, "test", &device()).expect("load with guide");
+    assert_eq!(loaded.guide.as_ref().map(|g| g.config.channels.clone()), Some(vec![4, 8]));
+
+    // A guide trained on other data has another normalisation: its inputs would mean something else.
+    let guide_json = dir.join("guide").join("test.json");
+    let text = std::fs::read_to_string(&guide_json).expect("read guide manifest");
+    std::fs::write(&guide_json, text.replace("\"cond_mean\": 10.0", "\"cond_mean\": 11.0")).expect("write");
+    let msg = load_model(&dir, "test", &device()).expect_err("mismatched guide").to_string();
+    assert!(msg.contains("guide/test.json") && msg.contains("normalisation"), "{msg}");
+
+    std::fs::remove_file(dir.join("guide").join("test.safetensors")).expect("remove");
+    let msg = load_model(&dir, "test", &device()).expect_err("guide weights gone").to_string();
+    assert!(msg.contains("guide/test.safetensors") && msg.contains("missing"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 fn manifest_for(net: &UNet) -> ModelManifest {
     let mut manifest =
         ModelManifest::new("test", net.config.clone(), Sampler::karras(SamplerKind::Renoise, 2, 0.3, 40.0, 7.0));
@@ -313,7 +360,7 @@ fn tiny_core(batch: usize) -> LearnedStage {
     manifest.window = 32;
     manifest.normalisation =
         Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
-    LearnedStage::new(LoadedModel { net, manifest }, device(), Arc::new(Hills), 42, batch)
+    LearnedStage::new(LoadedModel { net, manifest, guide: None }, device(), Arc::new(Hills), 42, batch)
 }
 
 /// A fine field (metres) and its coarse grid as the pipeline provides it: box means over
@@ -353,7 +400,7 @@ fn a_window_s_context_is_the_low_band_training_computes() {
     let net = perturbed_tiny(11);
     let mut manifest = manifest_for(&net);
     manifest.window = 32;
-    let stage = LearnedStage::new(LoadedModel { net, manifest }, device(), Arc::new(BoxMeans), 1, 1);
+    let stage = LearnedStage::new(LoadedModel { net, manifest, guide: None }, device(), Arc::new(BoxMeans), 1, 1);
     // Training: a 160² tile (origin on the 8-cell grid) encoded whole; the window sits in its
     // interior, away from the tile's clamped edges.
     let (t0, n) = ((-64i64, 40i64), 160usize);
@@ -391,7 +438,13 @@ fn the_relief_hint_steers_each_window_from_its_own_context() {
         r2: 0.9,
         offset: 0.2,
     });
-    let hinted = LearnedStage::new(LoadedModel { net, manifest: manifest.clone() }, device(), Arc::new(Hills), 42, 2);
+    let hinted = LearnedStage::new(
+        LoadedModel { net, manifest: manifest.clone(), guide: None },
+        device(),
+        Arc::new(Hills),
+        42,
+        2,
+    );
     // Each window's vector is the hint's prediction from that window's own low band.
     let windows = [Rect::new(0, 0, 32, 32), Rect::new(-80, 48, 32, 32)];
     let lows: Vec<Vec<f32>> = windows.iter().map(|&r| hinted.context(r).1).collect();
@@ -461,7 +514,7 @@ fn bench_core_windows_per_second() {
         manifest.sampler = Sampler::karras(SamplerKind::Euler, steps, 0.05, 80.0, 7.0);
         manifest.normalisation =
             Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
-        let model = LoadedModel { net: UNet::new(&UNetConfig::core(), 0, &device()), manifest };
+        let model = LoadedModel { net: UNet::new(&UNetConfig::core(), 0, &device()), manifest, guide: None };
         let engine = Engine::new(EngineConfig { cache_bytes: 256 << 20, threads: 2 });
         let tensor = Windowed::new(&engine, LearnedStage::new(model, device(), Arc::new(Hills), 1, 8));
         let t = std::time::Instant::now();

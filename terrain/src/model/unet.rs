@@ -57,19 +57,22 @@ impl UNetConfig {
         }
     }
 
+    /// This shape at half the width (channels, embedding and Fourier features halved): ≈ ¼
+    /// of the multiply–adds per pixel. The core's half is the detail stage's shape, and the
+    /// core's autoguidance guide (see [`Guidance`](super::Guidance)).
+    pub fn halved(&self) -> UNetConfig {
+        UNetConfig {
+            channels: self.channels.iter().map(|&c| (c / 2).max(1)).collect(),
+            emb_channels: (self.emb_channels / 2).max(1),
+            fourier_channels: (self.fourier_channels / 2).max(2),
+            ..self.clone()
+        }
+    }
+
     /// The detail stage's default: the core's shape at half the width (≈ ¼ of its cost per
     /// pixel), since it runs on 4× the pixels with twice the window overlap.
     pub fn detail() -> UNetConfig {
-        UNetConfig {
-            channels_out: 1,
-            channels_cond: 1,
-            vector_dim: 2,
-            channels: vec![16, 32, 48],
-            mid_blocks: 1,
-            emb_channels: 64,
-            fourier_channels: 32,
-            sigma_data: 0.5,
-        }
+        UNetConfig::core().halved()
     }
 
     /// A very small network for tests.
