@@ -27,6 +27,8 @@ struct Sidecar {
     z0: Option<i64>,
     #[serde(default)]
     grid: Option<Grid>,
+    #[serde(default)]
+    heldout_counterparts: Option<usize>,
 }
 
 /// One heightmap file and what its sidecar says about it.
@@ -42,6 +44,9 @@ pub struct Heightmap {
     pub origin: Option<(i64, i64)>,
     /// Array pixels per model pixel along each axis (1 on the model grid, 4 on the block grid).
     pub pixels_per_model_pixel: f64,
+    /// `Some(n)`: the tiles are generated counterparts of the first `n` held-out tiles of a
+    /// prepared set (`train <stage> --generate-heldout`), so they are compared with those.
+    pub heldout_counterparts: Option<usize>,
 }
 
 impl Heightmap {
@@ -85,6 +90,7 @@ impl Heightmap {
             origin,
             // From the resolution, so a prepared stack (no grid) is handled like an export.
             pixels_per_model_pixel: MODEL_PIXEL_METRES / side.metres_per_pixel,
+            heldout_counterparts: side.heldout_counterparts,
         })
     }
 
@@ -142,6 +148,21 @@ impl Reference {
         let heldout = Heightmap::load(path)?;
         let tile = heldout.tile.unwrap_or(DEFAULT_TILE);
         Ok(Reference { path: path.to_path_buf(), heldout, train: None, tile })
+    }
+
+    /// Keeps only the first `n` held-out tiles (when there are more): a generated set of
+    /// counterparts of the first `n` must be compared with those, not with all of them —
+    /// tiles differ from region to region far more than a model's error. Returns whether it
+    /// cut anything.
+    pub fn first_heldout_tiles(&mut self, n: usize) -> bool {
+        let Some(t) = self.heldout.tile else { return false };
+        let r = &mut self.heldout.raster;
+        if n == 0 || n * t >= r.rows {
+            return false;
+        }
+        r.rows = n * t;
+        r.data.truncate(r.rows * r.cols);
+        true
     }
 
     /// Reference resolution, metres per pixel.

@@ -108,8 +108,16 @@ pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report
     if args.seam_stride < 2 {
         return Err(EvalError::Input(format!("--seam-stride {} is too small (at least 2)", args.seam_stride)));
     }
-    let reference = Reference::load(&args.reference)?;
+    let mut reference = Reference::load(&args.reference)?;
     let generated = Heightmap::load(&args.generated)?;
+    if let Some(n) = generated.heldout_counterparts {
+        if reference.train.is_some() && reference.first_heldout_tiles(n) {
+            eprintln!(
+                "{} holds counterparts of the first {n} held-out tiles: the reference is those {n}",
+                args.generated.display()
+            );
+        }
+    }
     let (metres, size) = (reference.metres(), reference.tile);
     let gen_tiles = generated.tiles_at(metres, size);
     if gen_tiles.is_empty() {

@@ -78,6 +78,32 @@ fn the_realism_bar_passes_real_terrain_fails_rougher_terrain_and_is_recorded_in_
 }
 
 #[test]
+fn counterparts_of_the_first_heldout_tiles_are_compared_with_those_tiles_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = dir.path().join("core");
+    std::fs::create_dir(&set).unwrap();
+    write_split(&set, "heldout", 3, 64, 1);
+    write_split(&set, "train", 3, 64, 10);
+    // The first held-out tile itself, as `train core --generate-heldout --tiles 1` labels it.
+    let first = dir.path().join("first.npy");
+    let heldout = Raster::new(3 * 64, 64, 1000.0, crate::export::read_npy_f32(&set.join("heldout.npy")).unwrap().1);
+    write_npy_f32(&first, (64, 64), &heldout.data[..64 * 64]).unwrap();
+    let side = serde_json::json!({"metres_per_pixel": 1000.0, "tile": 64, "count": 1, "heldout_counterparts": 1});
+    std::fs::write(first.with_extension("json"), side.to_string()).unwrap();
+    let report = run(&args(&first, &set, &dir.path().join("a.png")), &mut |_, _| {}).unwrap();
+    assert_eq!(report.get("tiles", 0), Some("1"), "the reference is cut to the first tile");
+    let slope = report.targets.iter().find(|t| t.key == "slope_w1_deg").expect("slope target");
+    assert_eq!(slope.value, 0.0, "a tile is at distance 0 from itself");
+
+    // Without the label the same tile is compared with all three (other hills: not 0).
+    std::fs::write(first.with_extension("json"), r#"{"metres_per_pixel": 1000.0, "tile": 64}"#).unwrap();
+    let report = run(&args(&first, &set, &dir.path().join("b.png")), &mut |_, _| {}).unwrap();
+    assert_eq!(report.get("tiles", 0), Some("3"));
+    let slope = report.targets.iter().find(|t| t.key == "slope_w1_deg").expect("slope target");
+    assert!(slope.value > 0.0, "{slope:?}");
+}
+
+#[test]
 fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
     let dir = tempfile::tempdir().unwrap();
     let set = dir.path().join("core");

@@ -138,6 +138,7 @@ pub fn generate(
         "metres_per_pixel": model.manifest.metres_per_pixel,
         "tile": size,
         "count": count,
+        "heldout_counterparts": count,
         "stage": stage,
         "generator": format!("infiniterra train {stage} --generate-heldout (conditioned on each held-out tile's low band)"),
         "seed": seed,

@@ -27,6 +27,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         fit_relief_hint: false,
         calibrate_relief_hint: false,
         picture: PathBuf::from("unused.png"),
+        half_width: false,
         smoke: true,
     }
 }
@@ -69,6 +70,19 @@ fn training_is_deterministic_and_resumes_exactly() {
     assert!(resumed.join("checkpoints/core/samples_000004.png").exists());
     let _ = std::fs::remove_dir_all(&straight);
     let _ = std::fs::remove_dir_all(&resumed);
+}
+
+#[test]
+fn a_half_width_guide_trains_into_its_own_folder_and_its_manifest_says_how() {
+    let out = tempdir("guide");
+    let mut args = smoke_args(&out, 2, false);
+    args.half_width = true;
+    run(&args, Some(5)).expect("trains");
+    let manifest: ModelManifest =
+        serde_json::from_str(&std::fs::read_to_string(out.join("core.json")).expect("manifest")).expect("parses");
+    assert_eq!(manifest.architecture, UNetConfig::tiny().halved());
+    assert!(manifest.recreate.contains(&format!("--half-width --out {}", out.display())), "{}", manifest.recreate);
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
