@@ -86,8 +86,8 @@ fn counterparts_of_the_first_heldout_tiles_are_compared_with_those_tiles_only() 
     write_split(&set, "train", 3, 64, 10);
     // The first held-out tile itself, as `train core --generate-heldout --tiles 1` labels it.
     let first = dir.path().join("first.npy");
-    let heldout = Raster::new(3 * 64, 64, 1000.0, crate::export::read_npy_f32(&set.join("heldout.npy")).unwrap().1);
-    write_npy_f32(&first, (64, 64), &heldout.data[..64 * 64]).unwrap();
+    let (_, heldout) = crate::export::read_npy_f32(&set.join("heldout.npy")).unwrap();
+    write_npy_f32(&first, (64, 64), &heldout[..64 * 64]).unwrap();
     let side = serde_json::json!({"metres_per_pixel": 1000.0, "tile": 64, "count": 1, "heldout_counterparts": 1});
     std::fs::write(first.with_extension("json"), side.to_string()).unwrap();
     let report = run(&args(&first, &set, &dir.path().join("a.png")), &mut |_, _| {}).unwrap();

@@ -61,7 +61,7 @@ pub struct DataChecksum {
 /// How a stage is autoguided (see [`Guide`](super::Guide)).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Guidance {
-    /// The guide's own manifest, relative to this manifest's folder (e.g. `core_guide.json`).
+    /// The guide's own manifest, relative to this manifest's folder (e.g. `guide/core.json`).
     pub guide: String,
     /// Guidance weight `w` (1: the main model alone; the paper's best are 1.5–3).
     pub weight: f32,
