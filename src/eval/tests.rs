@@ -20,6 +20,15 @@ fn write_split(dir: &Path, name: &str, n: usize, tile: usize, seed: u64) {
     std::fs::write(dir.join(format!("{name}.json")), side.to_string()).unwrap();
 }
 
+/// A prepared set `<dir>/core/` of `heldout` held-out and 3 training 64² tiles.
+fn prepared_set(dir: &Path, heldout: usize) -> std::path::PathBuf {
+    let set = dir.join("core");
+    std::fs::create_dir(&set).unwrap();
+    write_split(&set, "heldout", heldout, 64, 1);
+    write_split(&set, "train", 3, 64, 10);
+    set
+}
+
 /// A generated map at 500 m with an export sidecar.
 fn write_generated(path: &Path, side: usize) {
     let r = hills(side, side, 500.0, 99);
@@ -44,10 +53,7 @@ fn args(generated: &Path, reference: &Path, out: &Path) -> EvalArgs {
 #[test]
 fn the_realism_bar_passes_real_terrain_fails_rougher_terrain_and_is_recorded_in_a_manifest() {
     let dir = tempfile::tempdir().unwrap();
-    let set = dir.path().join("core");
-    std::fs::create_dir(&set).unwrap();
-    write_split(&set, "heldout", 3, 64, 1);
-    write_split(&set, "train", 3, 64, 10);
+    let set = prepared_set(dir.path(), 3);
     // "Generated" = the held-out tiles themselves: every distance is 0.
     let same = dir.path().join("same.npy");
     std::fs::copy(set.join("heldout.npy"), &same).unwrap();
@@ -80,10 +86,7 @@ fn the_realism_bar_passes_real_terrain_fails_rougher_terrain_and_is_recorded_in_
 #[test]
 fn counterparts_of_the_first_heldout_tiles_are_compared_with_those_tiles_only() {
     let dir = tempfile::tempdir().unwrap();
-    let set = dir.path().join("core");
-    std::fs::create_dir(&set).unwrap();
-    write_split(&set, "heldout", 3, 64, 1);
-    write_split(&set, "train", 3, 64, 10);
+    let set = prepared_set(dir.path(), 3);
     // The first held-out tile itself, as `train core --generate-heldout --tiles 1` labels it.
     let first = dir.path().join("first.npy");
     let (_, heldout) = crate::export::read_npy_f32(&set.join("heldout.npy")).unwrap();
@@ -106,10 +109,7 @@ fn counterparts_of_the_first_heldout_tiles_are_compared_with_those_tiles_only() 
 #[test]
 fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
     let dir = tempfile::tempdir().unwrap();
-    let set = dir.path().join("core");
-    std::fs::create_dir(&set).unwrap();
-    write_split(&set, "heldout", 2, 64, 1);
-    write_split(&set, "train", 3, 64, 10);
+    let set = prepared_set(dir.path(), 2);
     let generated = dir.path().join("gen.npy");
     write_generated(&generated, 256);
     let out = dir.path().join("report/eval.png");

@@ -14,7 +14,7 @@ use std::sync::Arc;
 use burn::tensor::{Device, Tensor, TensorData};
 
 use super::store::{LoadedModel, Normalisation};
-use super::{Guide, ReliefHint, Sampler, UNet};
+use super::{Guidance, Guide, ReliefHint, Sampler, UNet};
 use crate::encoding::{blur, signed_sqrt, signed_square, ContextSpec};
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::noise::{GaussianNoise, NoiseKey};
@@ -39,7 +39,7 @@ pub fn noise_stream(stage: &str) -> u32 {
 pub struct LearnedStage {
     name: String,
     net: UNet,
-    guide: Option<(UNet, f32, usize)>,
+    guide: Option<(UNet, Guidance)>,
     device: Device,
     sampler: Sampler,
     norm: Normalisation,
@@ -65,7 +65,7 @@ impl LearnedStage {
             norm: model.manifest.normalisation.clone(),
             hint: model.manifest.relief_hint.clone(),
             spec: model.manifest.context,
-            guide: model.guide.zip(model.manifest.guidance.as_ref()).map(|(net, g)| (net, g.weight, g.steps)),
+            guide: model.guide.zip(model.manifest.guidance.clone()),
             net: model.net,
             device,
             coarse,
@@ -166,7 +166,7 @@ impl WindowFn for LearnedStage {
         let vector = self
             .conditioning_vector(&lows)
             .map(|v| Tensor::<2>::from_data(TensorData::new(v, [b, self.net.config.vector_dim]), &self.device));
-        let guide = self.guide.as_ref().map(|(net, weight, steps)| Guide { net, weight: *weight, steps: *steps });
+        let guide = self.guide.as_ref().map(|(net, g)| Guide { net, weight: g.weight, steps: g.steps });
         let out = self.sampler.sample_guided(&self.net, guide.as_ref(), &noises, Some(cond), vector);
         let values: Vec<f32> = out.into_data().try_into_vec().expect("the network outputs f32");
         rects
