@@ -78,7 +78,7 @@ pub(super) fn best(tried: &[Trial]) -> Option<Trial> {
 
 /// `count` tiles spread evenly over `tiles`, starting at `phase` of the spacing (0 or ½), so
 /// two calls with different phases pick disjoint sets.
-fn spread(tiles: &[EncodedTile], count: usize, phase: f64) -> Vec<&EncodedTile> {
+pub(super) fn spread(tiles: &[EncodedTile], count: usize, phase: f64) -> Vec<&EncodedTile> {
     let step = tiles.len() as f64 / count.max(1) as f64;
     (0..count.min(tiles.len())).map(|i| &tiles[(((i as f64 + phase) * step) as usize).min(tiles.len() - 1)]).collect()
 }

@@ -153,6 +153,13 @@ impl TileSet {
     /// The relief hint of this set: `relief_z` (as the conditioning vector holds it) regressed
     /// on the context statistics of [`HINT_CROPS`] fixed crops. Deterministic.
     pub fn relief_hint(&self, crop: usize, norm: &Normalisation) -> Option<ReliefHint> {
+        let (x, z) = self.relief_samples(crop, norm);
+        ReliefHint::fit(&x, &z)
+    }
+
+    /// Context features and true `relief_z` of [`HINT_CROPS`] fixed crops: what the hint is
+    /// fitted on, and what it is checked against on other tiles.
+    pub fn relief_samples(&self, crop: usize, norm: &Normalisation) -> (Vec<[f64; FEATURES]>, Vec<f64>) {
         let mut rng = HostRng::keyed(0, STREAM_HINT, 0, 0);
         let (mut x, mut z): (Vec<[f64; FEATURES]>, Vec<f64>) = (Vec::new(), Vec::new());
         for _ in 0..HINT_CROPS {
@@ -162,7 +169,7 @@ impl TileSet {
             x.push(features(&low, crop));
             z.push((log_std(&residual) - norm.relief_mean as f64) / norm.relief_std as f64);
         }
-        ReliefHint::fit(&x, &z)
+        (x, z)
     }
 
     /// The smallest tile side (crops must fit every tile).
@@ -240,7 +247,7 @@ impl TileSet {
 }
 
 /// ln of the standard deviation of a crop (floored so flat sea floor stays finite).
-fn log_std(v: &[f32]) -> f64 {
+pub(super) fn log_std(v: &[f32]) -> f64 {
     let m = v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
     let var = v.iter().map(|&x| (x as f64 - m).powi(2)).sum::<f64>() / v.len() as f64;
     (var.sqrt() + 1e-2).ln()
@@ -248,7 +255,7 @@ fn log_std(v: &[f32]) -> f64 {
 
 /// A `crop × crop` window of a per-pixel value of `t` at (y0, x0), under dihedral transform
 /// `d` (bit 0: transpose, bit 1: flip rows, bit 2: flip columns).
-fn crop_of(
+pub(super) fn crop_of(
     t: &EncodedTile,
     y0: usize,
     x0: usize,

@@ -15,6 +15,7 @@ pub mod data;
 mod ema;
 mod heldout;
 mod preview;
+mod response;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -116,6 +117,11 @@ pub struct TrainArgs {
     /// the realism bar (minutes), and write it into that manifest.
     #[arg(long)]
     pub calibrate_relief_hint: bool,
+    /// Instead of training: measure how much relief the shipped `<out>/<stage>.json` draws
+    /// when its hint is raised by 0, 1 and 2 on `--tiles` training tiles, and write the
+    /// inverted response (extra relief to ask for, by expected relief) into that manifest.
+    #[arg(long)]
+    pub calibrate_relief_response: bool,
     /// Train the stage's network at half the width (≈ ¼ of its cost per pixel). Trained
     /// briefly into its own `--out`, it is the shipped model's autoguidance guide: a "bad
     /// version of itself" whose errors guidance steers away from (`guide` in the manifest).
@@ -209,9 +215,10 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()
     let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let manifest: ModelManifest =
         serde_json::from_str(&text).with_context(|| format!("{} is not a model manifest", path.display()))?;
-    let (train, _) = stage_data(stage, data, manifest.context).map_err(|e| anyhow!(e))?;
+    let (train, heldout) = stage_data(stage, data, manifest.context).map_err(|e| anyhow!(e))?;
+    let (crop, norm) = (manifest.training.crop, &manifest.normalisation);
     let hint = train
-        .relief_hint(manifest.training.crop, &manifest.normalisation)
+        .relief_hint(crop, norm)
         .ok_or_else(|| anyhow!("{}: the relief-hint fit is singular on this data", data.display()))?;
     println!(
         "relief hint of {}: coefficients {:?} on {:?}, R² {:.3}",
@@ -219,6 +226,16 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()
         hint.coefficients,
         hint.features,
         hint.r2
+    );
+    // The fit is judged on crops it never saw: a bias there is relief the hint will not ask for.
+    let (x, z) = heldout.relief_samples(crop, norm);
+    let check = hint.check(&x, &z);
+    println!(
+        "on {} held-out crops: R² {:.3}, truth − hint {:+.3} z (rms {:.3})",
+        z.len(),
+        check.r2,
+        check.bias,
+        check.rms
     );
     let hint = serde_json::to_value(&hint)?;
     crate::manifest_edit::edit_manifest(&path, |object| {
@@ -295,6 +312,11 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     }
     if args.fit_relief_hint {
         return fit_relief_hint(&args.out, &args.stage, &args.data).map_err(Failure::runtime);
+    }
+    if args.calibrate_relief_response {
+        let seed = seed.unwrap_or(DEFAULT_SEED);
+        return response::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
+            .map_err(Failure::runtime);
     }
     if args.calibrate_relief_hint {
         let seed = seed.unwrap_or(DEFAULT_SEED);

@@ -26,6 +26,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         counterpart: None,
         fit_relief_hint: false,
         calibrate_relief_hint: false,
+        calibrate_relief_response: false,
         picture: PathBuf::from("unused.png"),
         half_width: false,
         smoke: true,
@@ -178,6 +179,41 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
     crate::export::write_npy_f32(&real, (64, 32), &metres[..64 * 32]).expect("write region");
     let err = heldout::compare(&dir, "core", &real, &png, 3, ComputeBackend::Cpu).expect_err("not square");
     assert!(err.to_string().contains("region.npy"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn calibrating_the_response_writes_ascending_knots_and_nothing_else() {
+    let dir = tempdir("response");
+    train(&smoke_args(&dir, 2, false));
+    let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
+    let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
+
+    let data_dir = dir.join("data");
+    std::fs::create_dir_all(data_dir.join("core")).expect("data dir");
+    let tiles = data::synthetic(2, data::PREPARED_TILE);
+    let stack: Vec<f32> =
+        tiles.tiles.iter().flat_map(|t| t.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h))).collect();
+    crate::export::write_npy_f32(&data_dir.join("core/train.npy"), (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack)
+        .expect("write");
+    response::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+
+    let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
+    let knots: Vec<[f64; 2]> =
+        serde_json::from_value(after["relief_hint"]["response"].clone()).expect("a response curve was written");
+    assert!(!knots.is_empty() && knots.windows(2).all(|w| w[1][0] > w[0][0]), "{knots:?}");
+    assert_eq!(after["relief_hint"]["offset"].as_f64(), Some(0.0), "the curve replaces the offset");
+    let without_curve = |v: &serde_json::Value| {
+        let mut v = v.clone();
+        let hint = v["relief_hint"].as_object_mut().expect("object");
+        hint.remove("response");
+        hint.remove("offset");
+        v
+    };
+    assert_eq!(without_curve(&after), without_curve(&before), "nothing but the curve and the offset changed");
+    let model = infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu"))
+        .expect("still loads");
+    assert_eq!(model.manifest.relief_hint.expect("hint").response, knots);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

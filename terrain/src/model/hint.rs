@@ -31,6 +31,25 @@ pub struct ReliefHint {
     /// `infiniterra train STAGE --calibrate-relief-hint` on training tiles; 0 until then.
     #[serde(default)]
     pub offset: f64,
+    /// The network's response curve, inverted: knots `[prediction, extra]` (predictions
+    /// ascending) of a piecewise-linear extra added to each prediction, flat beyond the end
+    /// knots. One offset cannot serve every window: the network draws gentle land about as
+    /// rough as it is asked to but falls further short the more relief it is asked for, so
+    /// rugged windows need a larger extra than flat ones. Measured by
+    /// `infiniterra train STAGE --calibrate-relief-response` on training tiles; empty until then.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub response: Vec<[f64; 2]>,
+}
+
+/// How a hint's predictions compare with the true `relief_z` of a set of crops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HintCheck {
+    /// Fraction of the variance explained.
+    pub r2: f64,
+    /// Mean of truth − prediction, z units: positive when the hint asks for too little.
+    pub bias: f64,
+    /// Root mean square of truth − prediction, z units.
+    pub rms: f64,
 }
 
 /// The context statistics of one square window of side `side`: its low band in signed-sqrt
@@ -84,24 +103,62 @@ impl ReliefHint {
             }
         }
         let coefficients: Vec<f64> = (0..FEATURES).map(|i| a[i][FEATURES] / a[i][i]).collect();
-        let mean = targets.iter().sum::<f64>() / targets.len() as f64;
-        let total: f64 = targets.iter().map(|t| (t - mean).powi(2)).sum();
-        let residual: f64 = x
-            .iter()
-            .zip(targets)
-            .map(|(row, t)| (t - row.iter().zip(&coefficients).map(|(f, c)| f * c).sum::<f64>()).powi(2))
-            .sum();
-        Some(ReliefHint {
+        let mut hint = ReliefHint {
             features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
             coefficients,
-            r2: if total > 0.0 { 1.0 - residual / total } else { 0.0 },
+            r2: 0.0,
             offset: 0.0,
-        })
+            response: Vec::new(),
+        };
+        hint.r2 = hint.check(x, targets).r2;
+        Some(hint)
     }
 
-    /// The predicted `relief_z` of a window whose low band is `low` (side `side`).
+    /// How well the fit (without its offset) predicts `targets` from the feature rows `x`:
+    /// on its own crops that is the fit's R²; on held-out crops it shows whether the hint
+    /// carries over, and which way it errs.
+    pub fn check(&self, x: &[[f64; FEATURES]], targets: &[f64]) -> HintCheck {
+        assert_eq!(x.len(), targets.len());
+        let n = targets.len().max(1) as f64;
+        let mean = targets.iter().sum::<f64>() / n;
+        let total: f64 = targets.iter().map(|t| (t - mean).powi(2)).sum();
+        let errors: Vec<f64> = x
+            .iter()
+            .zip(targets)
+            .map(|(row, t)| t - row.iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>())
+            .collect();
+        let residual: f64 = errors.iter().map(|e| e * e).sum();
+        HintCheck {
+            r2: if total > 0.0 { 1.0 - residual / total } else { 0.0 },
+            bias: errors.iter().sum::<f64>() / n,
+            rms: (residual / n).sqrt(),
+        }
+    }
+
+    /// The fit's estimate of the true `relief_z` of a window whose low band is `low` (side
+    /// `side`): what the window should look like, before any correction for the network.
+    pub fn expected(&self, low: &[f32], side: usize) -> f64 {
+        features(low, side).iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>()
+    }
+
+    /// What the network is asked for in a window whose low band is `low` (side `side`): the
+    /// expected relief, plus the response curve's extra there, plus the offset.
     pub fn predict(&self, low: &[f32], side: usize) -> f32 {
-        (features(low, side).iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>() + self.offset) as f32
+        let expected = self.expected(low, side);
+        (expected + self.extra(expected) + self.offset) as f32
+    }
+
+    /// The response curve at `expected` (0 without one): linear between knots, flat beyond.
+    pub fn extra(&self, expected: f64) -> f64 {
+        let knots = &self.response;
+        match knots.iter().position(|k| k[0] > expected) {
+            None => knots.last().map_or(0.0, |k| k[1]),
+            Some(0) => knots[0][1],
+            Some(i) => {
+                let ([x0, y0], [x1, y1]) = (knots[i - 1], knots[i]);
+                y0 + (y1 - y0) * (expected - x0) / (x1 - x0)
+            }
+        }
     }
 
     /// Checks the manifest entry has the shape this code computes.
@@ -114,6 +171,14 @@ impl ReliefHint {
         }
         if !self.offset.is_finite() {
             return Err(format!("relief_hint.offset = {} is not a finite number", self.offset));
+        }
+        if self.response.iter().flatten().any(|v| !v.is_finite())
+            || self.response.windows(2).any(|w| w[1][0] <= w[0][0])
+        {
+            return Err(format!(
+                "relief_hint.response = {:?}: knots must be finite [prediction, extra] pairs with predictions strictly ascending",
+                self.response
+            ));
         }
         Ok(())
     }
@@ -145,6 +210,10 @@ mod tests {
             assert!((c - t).abs() < 1e-6, "{:?} vs {truth:?}", hint.coefficients);
         }
         assert!(hint.r2 > 0.999_999);
+        // Truth half a unit above every prediction: a bias of +0.5, nothing else.
+        let raised: Vec<f64> = y.iter().map(|v| v + 0.5).collect();
+        let check = hint.check(&x, &raised);
+        assert!((check.bias - 0.5).abs() < 1e-6 && (check.rms - 0.5).abs() < 1e-6, "{check:?}");
         assert!((hint.predict(&windows[7], side) as f64 - y[7]).abs() < 1e-4);
         hint.validate().expect("fresh fit is valid");
         // The calibration offset shifts every prediction by itself, nothing else.
@@ -154,11 +223,30 @@ mod tests {
     }
 
     #[test]
+    fn the_response_curve_adds_its_extra_by_expected_relief_and_stays_flat_beyond_its_knots() {
+        let hint = ReliefHint {
+            features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
+            coefficients: vec![0.0; FEATURES],
+            response: vec![[-1.0, 0.0], [1.0, 1.0], [2.0, 2.5]],
+            ..Default::default()
+        };
+        hint.validate().expect("ascending knots are valid");
+        for (at, extra) in [(-5.0, 0.0), (-1.0, 0.0), (0.0, 0.5), (1.0, 1.0), (1.5, 1.75), (2.0, 2.5), (9.0, 2.5)] {
+            assert!((hint.extra(at) - extra).abs() < 1e-12, "extra({at}) = {} not {extra}", hint.extra(at));
+        }
+        // Zero coefficients: every window's expected relief is 0, so it is asked for 0 + 0.5.
+        assert!((hint.predict(&[1.0; 16], 4) - 0.5).abs() < 1e-6);
+        assert_eq!(ReliefHint::default().extra(3.0), 0.0, "no curve, no extra");
+        let unsorted = ReliefHint { response: vec![[1.0, 0.0], [1.0, 1.0]], ..hint };
+        assert!(unsorted.validate().unwrap_err().contains("relief_hint.response"));
+    }
+
+    #[test]
     fn a_degenerate_sample_set_is_refused_and_a_foreign_manifest_entry_is_named() {
         let flat = vec![3.0f32; 64];
         let x = vec![features(&flat, 8); 10];
         assert_eq!(ReliefHint::fit(&x, &[1.0; 10]), None);
-        let bad = ReliefHint { features: vec!["1".into()], coefficients: vec![0.0], r2: 0.0, offset: 0.0 };
+        let bad = ReliefHint { features: vec!["1".into()], coefficients: vec![0.0], ..Default::default() };
         assert!(bad.validate().unwrap_err().contains("relief_hint.features"));
     }
 }

@@ -30,7 +30,7 @@ use burn::tensor::Device;
 pub use burn;
 
 pub use edm::{edm_loss, NoiseDistribution};
-pub use hint::ReliefHint;
+pub use hint::{HintCheck, ReliefHint};
 pub use layers::{force_normalize, mp_cat, mp_silu, mp_sum, normalize_rows, pixel_norm, MpConv, MpLinear};
 pub use rng::HostRng;
 pub use sampler::{Guide, Sampler, SamplerKind};

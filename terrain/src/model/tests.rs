@@ -437,6 +437,7 @@ fn the_relief_hint_steers_each_window_from_its_own_context() {
         coefficients: vec![0.5, 0.1, 0.8, 0.3],
         r2: 0.9,
         offset: 0.2,
+        response: Vec::new(),
     });
     let hinted = LearnedStage::new(
         LoadedModel { net, manifest: manifest.clone(), guide: None },
