@@ -69,6 +69,14 @@ pub struct TrainArgs {
     /// EMA decay of the shipped weights.
     #[arg(long, default_value_t = 0.999)]
     pub ema: f32,
+    /// Mean of ln σ of the training noise levels (EDM: −1.2). Higher puts more of the
+    /// training at the high noise levels where a few-step sampler's first steps lay out the
+    /// large-scale structure.
+    #[arg(long, default_value_t = -1.2, allow_hyphen_values = true)]
+    pub p_mean: f32,
+    /// Standard deviation of ln σ of the training noise levels (EDM: 1.2).
+    #[arg(long, default_value_t = 1.2)]
+    pub p_std: f32,
     /// Prepared data folder (holding `core/`, `detail/`, …).
     #[arg(long, default_value = "data/prepared")]
     pub data: PathBuf,
@@ -266,6 +274,9 @@ struct CheckpointState {
     /// from, and that manifest's path (both go into the shipped `recreate`).
     #[serde(default)]
     continues: Option<(String, PathBuf)>,
+    /// Training noise levels (checkpoints written before they were recorded used EDM's).
+    #[serde(default)]
+    noise: NoiseDistribution,
 }
 
 /// Paths of a stage's checkpoint.
@@ -375,7 +386,6 @@ impl Trainer {
         let device = plain.clone().autodiff();
         let paths = CheckpointPaths { dir: args.out.join("checkpoints").join(&args.stage) };
         let optim = AdamConfig::new().with_beta_1(0.9).with_beta_2(0.99).with_epsilon(1e-8).init();
-        let noise = NoiseDistribution::default();
         let (net, ema, optim, state) = if args.resume {
             let text = std::fs::read_to_string(paths.state()).map_err(|e| {
                 Failure::input(anyhow!(
@@ -432,6 +442,7 @@ impl Trainer {
                 losses: Vec::new(),
                 validation: Vec::new(),
                 continues: Some((m.recreate.clone(), path.clone())),
+                noise: NoiseDistribution { p_mean: args.p_mean, p_std: args.p_std },
             };
             eprintln!(
                 "continuing {} from {} at step {} (seed {})",
@@ -461,9 +472,11 @@ impl Trainer {
                 losses: Vec::new(),
                 validation: Vec::new(),
                 continues: None,
+                noise: NoiseDistribution { p_mean: args.p_mean, p_std: args.p_std },
             };
             (net, ema, optim, state)
         };
+        let noise = state.noise;
         let mut t =
             Trainer { args: args.clone(), spec, device, plain, net, ema, optim, state, train, heldout, noise, paths };
         // A resumed run keeps its batch, crop and schedule: they define which samples each
@@ -650,6 +663,7 @@ impl Trainer {
             learning_rate: self.state.lr,
             ema_beta: self.state.ema,
             lr_ref_steps: self.state.lr_ref_steps,
+            noise: (self.state.noise != NoiseDistribution::default()).then_some(self.state.noise),
             final_loss: self.state.losses.last().map_or(f32::NAN, |l| l.1),
             wall_seconds: self.state.wall_seconds,
         };
@@ -670,7 +684,7 @@ impl Trainer {
         // machine-dependent step; this names the step it reached).
         let s = &self.state;
         let this_run = format!(
-            "infiniterra train {}{}{} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {} --precision {}",
+            "infiniterra train {}{}{} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {}{} --precision {}",
             s.stage,
             // A guide is the half-width network in its own folder (`models/guide/`).
             if self.args.half_width { format!(" --half-width --out {}", self.args.out.display()) } else { String::new() },
@@ -682,6 +696,11 @@ impl Trainer {
             s.lr,
             s.lr_ref_steps,
             s.ema,
+            if s.noise == NoiseDistribution::default() {
+                String::new()
+            } else {
+                format!(" --p-mean {} --p-std {}", s.noise.p_mean, s.noise.p_std)
+            },
             match self.args.precision {
                 Precision::F16 => "f16",
                 Precision::F32 => "f32",

@@ -13,6 +13,8 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         lr: 4e-3,
         lr_ref_steps: 2,
         ema: 0.9,
+        p_mean: -1.2,
+        p_std: 1.2,
         data: PathBuf::from("unused"),
         out: out.to_path_buf(),
         checkpoint_every: 2,
@@ -93,8 +95,10 @@ fn a_shipped_model_continues_training_from_its_weights_and_step() {
     let continued = tempdir("continued");
     let mut args = smoke_args(&continued, 4, false);
     args.init_from = Some(first.join("core.json"));
-    // Different settings on the command line are overridden by the shipped record.
+    // Different settings on the command line are overridden by the shipped record, but the
+    // noise levels are this run's own choice (continuing with more weight on high σ).
     args.batch = 3;
+    args.p_mean = -0.4;
     let state = train(&args);
     assert_eq!((state.step, state.batch), (4, 2), "continues at the shipped step with the shipped batch");
     assert!(state.losses.iter().all(|&(k, l)| k > 2 && l.is_finite()), "{:?}", state.losses);
@@ -109,6 +113,9 @@ fn a_shipped_model_continues_training_from_its_weights_and_step() {
     let (before, after) = manifest.recreate.split_once(" && ").expect("recreate chains both runs");
     assert_eq!(before, start.recreate);
     assert!(after.contains("--init-from ") && after.contains("--steps 4"), "{after}");
+    assert!(after.contains("--p-mean -0.4 --p-std 1.2") && !before.contains("--p-mean"), "{after}");
+    assert_eq!(manifest.training.noise, Some(NoiseDistribution { p_mean: -0.4, p_std: 1.2 }));
+    assert_eq!(start.training.noise, None, "EDM's default noise levels are not spelled out");
 
     // Another stage's (or architecture's) manifest is refused, naming the file.
     let mut wrong = smoke_args(&tempdir("wrong"), 4, false);
@@ -194,8 +201,12 @@ fn calibrating_the_response_writes_ascending_knots_and_nothing_else() {
     let tiles = data::synthetic(2, data::PREPARED_TILE);
     let stack: Vec<f32> =
         tiles.tiles.iter().flat_map(|t| t.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h))).collect();
-    crate::export::write_npy_f32(&data_dir.join("core/train.npy"), (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack)
-        .expect("write");
+    crate::export::write_npy_f32(
+        &data_dir.join("core/train.npy"),
+        (2 * data::PREPARED_TILE, data::PREPARED_TILE),
+        &stack,
+    )
+    .expect("write");
     response::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
 
     let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");

@@ -87,6 +87,9 @@ pub struct TrainingRecord {
     /// Steps before the learning rate decays (0 in manifests written before it was recorded).
     #[serde(default)]
     pub lr_ref_steps: u64,
+    /// Training noise levels, when not EDM's default (`ln σ ~ N(−1.2, 1.2²)`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<super::edm::NoiseDistribution>,
     /// Mean loss over the last logging interval.
     pub final_loss: f32,
     /// Wall-clock seconds spent training (all sessions).
