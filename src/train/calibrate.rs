@@ -9,12 +9,13 @@
 //! for a grid of offsets, each set is scored against those tiles with the bar's own yardsticks,
 //! and the best offset is written into the manifest. The weights are untouched.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::anyhow;
 use infiniterra_terrain::encoding::signed_square;
-use infiniterra_terrain::model::{load_model, ComputeBackend};
+use infiniterra_terrain::model::burn::tensor::Device;
+use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel, ReliefHint};
 
 use super::data::{read_split, EncodedTile};
 use super::heldout::counterpart;
@@ -87,6 +88,40 @@ fn raster(tile: &EncodedTile, metres: f64) -> Raster {
     Raster::new(tile.size, tile.size, metres, tile.h.iter().map(|&v| signed_square(v)).collect())
 }
 
+/// The shipped `<models>/<stage>.json` with its weights on `backend`, its path and its relief
+/// hint; an error naming the command that fits one when it has none.
+pub(super) fn load_hinted(
+    models: &Path,
+    stage: &str,
+    backend: ComputeBackend,
+) -> anyhow::Result<(LoadedModel, Device, PathBuf, ReliefHint)> {
+    let device = backend.device()?;
+    let model = load_model(models, stage, &device)?;
+    let path = models.join(format!("{stage}.json"));
+    let Some(hint) = model.manifest.relief_hint.clone() else {
+        anyhow::bail!(
+            "{} has no relief hint to calibrate: run `infiniterra train {stage} --fit-relief-hint` first",
+            path.display()
+        );
+    };
+    Ok((model, device, path, hint))
+}
+
+/// Writes `fields` into the `relief_hint` object of the manifest at `path`, leaving the rest
+/// of the file as it was.
+pub(super) fn write_hint_fields(path: &Path, fields: Vec<(&str, serde_json::Value)>) -> anyhow::Result<()> {
+    crate::manifest_edit::edit_manifest(path, |object| {
+        let hint = object
+            .get_mut("relief_hint")
+            .and_then(|h| h.as_object_mut())
+            .ok_or_else(|| anyhow!("{}: relief_hint vanished while calibrating", path.display()))?;
+        for (key, value) in fields {
+            hint.insert(key.into(), value);
+        }
+        Ok(())
+    })
+}
+
 /// Runs the calibration for `<models>/<stage>.json` on `count` training tiles and writes the
 /// chosen `relief_hint.offset` into the manifest.
 pub fn run(
@@ -97,15 +132,7 @@ pub fn run(
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
-    let device = backend.device()?;
-    let mut model = load_model(models, stage, &device)?;
-    let path = models.join(format!("{stage}.json"));
-    if model.manifest.relief_hint.is_none() {
-        anyhow::bail!(
-            "{} has no relief hint to calibrate: run `infiniterra train {stage} --fit-relief-hint` first",
-            path.display()
-        );
-    }
+    let (mut model, device, path, _) = load_hinted(models, stage, backend)?;
     let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
     if train.tiles.len() < 4 {
         anyhow::bail!(
@@ -173,14 +200,7 @@ pub fn run(
         summary.join("; ")
     );
 
-    crate::manifest_edit::edit_manifest(&path, |object| {
-        let hint = object
-            .get_mut("relief_hint")
-            .and_then(|h| h.as_object_mut())
-            .ok_or_else(|| anyhow!("{}: relief_hint vanished while calibrating", path.display()))?;
-        hint.insert("offset".into(), serde_json::json!(best));
-        Ok(())
-    })
+    write_hint_fields(&path, vec![("offset", serde_json::json!(best))])
 }
 
 #[cfg(test)]

@@ -18,9 +18,9 @@ use std::time::Instant;
 
 use anyhow::anyhow;
 use infiniterra_terrain::encoding::signed_sqrt;
-use infiniterra_terrain::model::{load_model, ComputeBackend, Normalisation, ReliefHint};
+use infiniterra_terrain::model::{ComputeBackend, Normalisation, ReliefHint};
 
-use super::calibrate::spread;
+use super::calibrate::{load_hinted, spread, write_hint_fields};
 use super::data::{crop_of, log_std, read_split, EncodedTile};
 use super::heldout::counterpart;
 
@@ -105,15 +105,7 @@ pub fn run(
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
-    let device = backend.device()?;
-    let mut model = load_model(models, stage, &device)?;
-    let path = models.join(format!("{stage}.json"));
-    let Some(hint) = model.manifest.relief_hint.clone() else {
-        anyhow::bail!(
-            "{} has no relief hint to calibrate: run `infiniterra train {stage} --fit-relief-hint` first",
-            path.display()
-        );
-    };
+    let (mut model, device, path, hint) = load_hinted(models, stage, backend)?;
     let spec = model.manifest.context;
     let train = read_split(&data.join(stage), "train", 1, spec).map_err(|e| anyhow!(e))?;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
@@ -154,16 +146,7 @@ pub fn run(
     }
     let shown: Vec<String> = response.iter().map(|[x, e]| format!("{x:+.2} → {e:+.2}")).collect();
     println!("relief hint of {}: response (expected → extra) {}; offset reset to 0", path.display(), shown.join(", "));
-    let response = serde_json::to_value(&response)?;
-    crate::manifest_edit::edit_manifest(&path, |object| {
-        let hint = object
-            .get_mut("relief_hint")
-            .and_then(|h| h.as_object_mut())
-            .ok_or_else(|| anyhow!("{}: relief_hint vanished while calibrating", path.display()))?;
-        hint.insert("response".into(), response);
-        hint.insert("offset".into(), serde_json::json!(0.0));
-        Ok(())
-    })
+    write_hint_fields(&path, vec![("response", serde_json::to_value(&response)?), ("offset", serde_json::json!(0.0))])
 }
 
 #[cfg(test)]
