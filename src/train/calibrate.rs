@@ -17,7 +17,7 @@ use infiniterra_terrain::encoding::signed_square;
 use infiniterra_terrain::model::burn::tensor::Device;
 use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel, ReliefHint};
 
-use super::data::{read_split, EncodedTile};
+use super::data::{read_split, EncodedTile, TileSet};
 use super::heldout::counterpart;
 use crate::eval::{realism_bar, Target};
 use crate::terrain::metrics::Raster;
@@ -88,13 +88,19 @@ fn raster(tile: &EncodedTile, metres: f64) -> Raster {
     Raster::new(tile.size, tile.size, metres, tile.h.iter().map(|&v| signed_square(v)).collect())
 }
 
-/// The shipped `<models>/<stage>.json` with its weights on `backend`, its path and its relief
-/// hint; an error naming the command that fits one when it has none.
-pub(super) fn load_hinted(
-    models: &Path,
-    stage: &str,
-    backend: ComputeBackend,
-) -> anyhow::Result<(LoadedModel, Device, PathBuf, ReliefHint)> {
+/// What both calibrations start from: the shipped model, its device, manifest path, relief
+/// hint, and the stage's training tiles (from `data`) encoded with its context.
+pub(super) struct Hinted {
+    pub model: LoadedModel,
+    pub device: Device,
+    pub path: PathBuf,
+    pub hint: ReliefHint,
+    pub train: TileSet,
+}
+
+/// Loads `<models>/<stage>.json` with its weights on `backend` and the stage's training tiles;
+/// an error naming the command that fits a hint when the model has none.
+pub(super) fn load_hinted(models: &Path, stage: &str, data: &Path, backend: ComputeBackend) -> anyhow::Result<Hinted> {
     let device = backend.device()?;
     let model = load_model(models, stage, &device)?;
     let path = models.join(format!("{stage}.json"));
@@ -104,7 +110,8 @@ pub(super) fn load_hinted(
             path.display()
         );
     };
-    Ok((model, device, path, hint))
+    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
+    Ok(Hinted { model, device, path, hint, train })
 }
 
 /// Writes `fields` into the `relief_hint` object of the manifest at `path`, leaving the rest
@@ -132,8 +139,7 @@ pub fn run(
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
-    let (mut model, device, path, _) = load_hinted(models, stage, backend)?;
-    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
+    let Hinted { mut model, device, path, train, .. } = load_hinted(models, stage, data, backend)?;
     if train.tiles.len() < 4 {
         anyhow::bail!(
             "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",

@@ -16,12 +16,11 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::anyhow;
 use infiniterra_terrain::encoding::signed_sqrt;
 use infiniterra_terrain::model::{ComputeBackend, Normalisation, ReliefHint};
 
-use super::calibrate::{load_hinted, spread, write_hint_fields};
-use super::data::{crop_of, log_std, read_split, EncodedTile};
+use super::calibrate::{load_hinted, spread, write_hint_fields, Hinted};
+use super::data::{crop_of, log_std, EncodedTile};
 use super::heldout::counterpart;
 
 /// Offsets the hint is raised by while probing (z units). The largest needs to reach past
@@ -105,9 +104,8 @@ pub fn run(
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
-    let (mut model, device, path, hint) = load_hinted(models, stage, backend)?;
+    let Hinted { mut model, device, path, hint, train } = load_hinted(models, stage, data, backend)?;
     let spec = model.manifest.context;
-    let train = read_split(&data.join(stage), "train", 1, spec).map_err(|e| anyhow!(e))?;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
     let (window, norm) = (model.manifest.window, model.manifest.normalisation.clone());
 

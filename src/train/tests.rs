@@ -189,24 +189,27 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn calibrating_the_response_writes_ascending_knots_and_nothing_else() {
-    let dir = tempdir("response");
+/// A smoke-trained core in a fresh folder `name`, and `count` real-looking 256² training tiles
+/// (metres) written to its `data/core/train.npy`: (folder, data folder, the tiles' stack).
+fn smoke_core_with_training_tiles(name: &str, count: usize) -> (PathBuf, PathBuf, Vec<f32>) {
+    let dir = tempdir(name);
     train(&smoke_args(&dir, 2, false));
-    let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
-    let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
-
     let data_dir = dir.join("data");
     std::fs::create_dir_all(data_dir.join("core")).expect("data dir");
-    let tiles = data::synthetic(2, data::PREPARED_TILE);
+    let tiles = data::synthetic(count, data::PREPARED_TILE);
     let stack: Vec<f32> =
         tiles.tiles.iter().flat_map(|t| t.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h))).collect();
-    crate::export::write_npy_f32(
-        &data_dir.join("core/train.npy"),
-        (2 * data::PREPARED_TILE, data::PREPARED_TILE),
-        &stack,
-    )
-    .expect("write");
+    let train_npy = data_dir.join("core/train.npy");
+    crate::export::write_npy_f32(&train_npy, (count * data::PREPARED_TILE, data::PREPARED_TILE), &stack)
+        .expect("write");
+    (dir, data_dir, stack)
+}
+
+#[test]
+fn calibrating_the_response_writes_ascending_knots_and_nothing_else() {
+    let (dir, data_dir, _) = smoke_core_with_training_tiles("response", 2);
+    let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
+    let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
     response::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
 
     let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
@@ -230,19 +233,11 @@ fn calibrating_the_response_writes_ascending_knots_and_nothing_else() {
 
 #[test]
 fn calibrating_the_relief_hint_changes_only_its_offset() {
-    let dir = tempdir("calibrate");
-    train(&smoke_args(&dir, 2, false));
+    // Four real-looking 256² training tiles: two to generate, two for the floor.
+    let (dir, data_dir, stack) = smoke_core_with_training_tiles("calibrate", 4);
+    let train_npy = data_dir.join("core/train.npy");
     let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
     let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
-
-    // Four real-looking 256² training tiles: two to generate, two for the floor.
-    let data_dir = dir.join("data");
-    std::fs::create_dir_all(data_dir.join("core")).expect("data dir");
-    let tiles = data::synthetic(4, data::PREPARED_TILE);
-    let stack: Vec<f32> =
-        tiles.tiles.iter().flat_map(|t| t.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h))).collect();
-    let train_npy = data_dir.join("core/train.npy");
-    crate::export::write_npy_f32(&train_npy, (4 * data::PREPARED_TILE, data::PREPARED_TILE), &stack).expect("write");
     calibrate::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
 
     let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
