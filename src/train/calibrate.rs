@@ -102,7 +102,10 @@ pub(super) struct Hinted {
 /// an error naming the command that fits a hint when the model has none.
 pub(super) fn load_hinted(models: &Path, stage: &str, data: &Path, backend: ComputeBackend) -> anyhow::Result<Hinted> {
     let device = backend.device()?;
-    let model = load_model(models, stage, &device)?;
+    let mut model = load_model(models, stage, &device)?;
+    // Both calibrations measure the network's own answer: the equaliser is calibrated on it
+    // afterwards.
+    model.manifest.spectral_equaliser = None;
     let path = models.join(format!("{stage}.json"));
     let Some(hint) = model.manifest.relief_hint.clone() else {
         anyhow::bail!(

@@ -16,6 +16,7 @@ mod ema;
 mod heldout;
 mod preview;
 mod response;
+mod spectrum;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -130,6 +131,12 @@ pub struct TrainArgs {
     /// inverted response (extra relief to ask for, by expected relief) into that manifest.
     #[arg(long)]
     pub calibrate_relief_response: bool,
+    /// Instead of training: compare the spectra of `--tiles` training tiles and of the shipped
+    /// `<out>/<stage>.json`'s counterparts of them, and write the spectral equaliser (gain per
+    /// wavelength) that brings the second to the first into that manifest. Run it after
+    /// `--calibrate-relief-response`.
+    #[arg(long)]
+    pub calibrate_spectrum: bool,
     /// Train the stage's network at half the width (≈ ¼ of its cost per pixel). Trained
     /// briefly into its own `--out`, it is the shipped model's autoguidance guide: a "bad
     /// version of itself" whose errors guidance steers away from (`guide` in the manifest).
@@ -327,6 +334,11 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     if args.calibrate_relief_response {
         let seed = seed.unwrap_or(DEFAULT_SEED);
         return response::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
+            .map_err(Failure::runtime);
+    }
+    if args.calibrate_spectrum {
+        let seed = seed.unwrap_or(DEFAULT_SEED);
+        return spectrum::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
             .map_err(Failure::runtime);
     }
     if args.calibrate_relief_hint {

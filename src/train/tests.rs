@@ -29,6 +29,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         fit_relief_hint: false,
         calibrate_relief_hint: false,
         calibrate_relief_response: false,
+        calibrate_spectrum: false,
         picture: PathBuf::from("unused.png"),
         half_width: false,
         smoke: true,
@@ -259,5 +260,29 @@ fn calibrating_the_relief_hint_changes_only_its_offset() {
         .expect("write");
     let err = calibrate::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect_err("two tiles");
     assert!(err.to_string().contains("at least 4"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn calibrating_the_spectrum_writes_a_loadable_equaliser_measured_without_the_old_one() {
+    let (dir, data_dir, _) = smoke_core_with_training_tiles("spectrum", 2);
+    let read = || -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("core.json")).expect("manifest")).expect("JSON")
+    };
+    let before = read();
+    spectrum::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+    let first = read();
+    let eq: infiniterra_terrain::model::SpectralEqualiser =
+        serde_json::from_value(first["spectral_equaliser"].clone()).expect("an equaliser was written");
+    eq.validate().expect("valid gains");
+    assert_eq!(eq.gains[1], [spectrum::KNOTS[0], 1.0], "the longest wavelengths are left alone");
+    let mut rest = first.clone();
+    rest.as_object_mut().expect("object").remove("spectral_equaliser");
+    assert_eq!(rest, before, "nothing but the equaliser changed");
+    // The model still loads with it, and a second calibration measures the network itself,
+    // not the network through the first equaliser: the same gains again.
+    infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).expect("loads");
+    spectrum::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates again");
+    assert_eq!(read()["spectral_equaliser"], first["spectral_equaliser"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -12,6 +12,7 @@
 
 mod cpu_conv;
 mod edm;
+pub mod equaliser;
 pub mod hint;
 mod layers;
 mod rng;
@@ -30,6 +31,7 @@ use burn::tensor::Device;
 pub use burn;
 
 pub use edm::{edm_loss, NoiseDistribution};
+pub use equaliser::SpectralEqualiser;
 pub use hint::{HintCheck, ReliefHint};
 pub use layers::{force_normalize, mp_cat, mp_silu, mp_sum, normalize_rows, pixel_norm, MpConv, MpLinear};
 pub use rng::HostRng;

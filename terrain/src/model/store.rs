@@ -15,6 +15,7 @@ use burn::tensor::{DType, Device};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::equaliser::SpectralEqualiser;
 use super::hint::ReliefHint;
 use super::sampler::Sampler;
 use super::unet::{UNet, UNetConfig};
@@ -135,6 +136,10 @@ pub struct ModelManifest {
     /// stage runs with the vector dropped (zeros), as older manifests did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relief_hint: Option<ReliefHint>,
+    /// A fixed filter on the stage's output that corrects its power spectrum (none: the
+    /// output as the network draws it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spectral_equaliser: Option<SpectralEqualiser>,
     /// The sampler to run it with.
     pub sampler: Sampler,
     /// Autoguidance by a weaker model of the same stage (none: the model runs alone).
@@ -183,6 +188,7 @@ impl ModelManifest {
             context: ContextSpec::default(),
             normalisation: Normalisation::default(),
             relief_hint: None,
+            spectral_equaliser: None,
             sampler,
             guidance: None,
             training: TrainingRecord::default(),
@@ -345,6 +351,9 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
     }
     if let Some(hint) = &manifest.relief_hint {
         hint.validate().map_err(manifest_corrupt)?;
+    }
+    if let Some(eq) = &manifest.spectral_equaliser {
+        eq.validate().map_err(manifest_corrupt)?;
     }
     if !(manifest.metres_per_pixel.is_finite() && manifest.metres_per_pixel > 0.0) {
         return Err(manifest_corrupt(format!("metres_per_pixel = {} (must be positive)", manifest.metres_per_pixel)));
