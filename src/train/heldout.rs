@@ -12,7 +12,6 @@ use anyhow::Context;
 use infiniterra_terrain::encoding::{box_downsample, signed_sqrt, signed_square};
 use infiniterra_terrain::infinite::{Engine, EngineConfig, Source, Windowed};
 use infiniterra_terrain::model::burn::tensor::Device;
-use infiniterra_terrain::model::equaliser::equalised;
 use infiniterra_terrain::model::stage::LearnedStage;
 use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel};
 use infiniterra_terrain::tile::{Rect, Tile};
@@ -53,9 +52,7 @@ pub(super) fn counterpart(model: &LoadedModel, device: &Device, h: &[f32], n: us
     let coarse = ClampedGrid { size: (n / f) as i64, metres: means.iter().map(|&v| signed_square(v)).collect() };
     let engine = Engine::new(EngineConfig { cache_bytes: 256 << 20, threads: 2 });
     let stage = Windowed::new(&engine, LearnedStage::new(model.clone(), device.clone(), Arc::new(coarse), seed, 8));
-    let name = &model.manifest.stage;
-    let output = equalised(&engine, name, stage.clone(), model.manifest.spectral_equaliser.as_ref());
-    let t = output.query(Rect::new(0, 0, n as i64, n as i64));
+    let t = stage.query(Rect::new(0, 0, n as i64, n as i64));
     (t.data, stage.evaluations())
 }
 

@@ -99,7 +99,8 @@ pub fn run(
     // The kernel's radius smooths the gain curve (by about a quarter octave at 32 pixels), so
     // one pass undershoots the narrow 16–32 km dip; a second pass multiplies in what is left.
     for pass in 1..=PASSES {
-        eq.validate().map_err(|e| anyhow!("the measured gains are out of range ({e}): is this model trained?"))?;
+        eq.validate(model.manifest.window)
+            .map_err(|e| anyhow!("the measured gains are out of range ({e}): is this model trained?"))?;
         model.manifest.spectral_equaliser = Some(eq.clone());
         let after = generated_spectrum(&model, &device, &tiles, seed).ok_or_else(|| anyhow!("no counterparts"))?;
         eprintln!(

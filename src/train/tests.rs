@@ -274,7 +274,7 @@ fn calibrating_the_spectrum_writes_a_loadable_equaliser_measured_without_the_old
     let first = read();
     let eq: infiniterra_terrain::model::SpectralEqualiser =
         serde_json::from_value(first["spectral_equaliser"].clone()).expect("an equaliser was written");
-    eq.validate().expect("valid gains");
+    eq.validate(64).expect("valid gains");
     assert_eq!(eq.gains[1], [spectrum::KNOTS[0], 1.0], "the longest wavelengths are left alone");
     let mut rest = first.clone();
     rest.as_object_mut().expect("object").remove("spectral_equaliser");

@@ -9,18 +9,19 @@
 //! blending stride and sampler tried), so a linear filter whose amplitude gain is
 //! √(real power / generated power) per wavelength corrects them. Its gains are measured by
 //! `infiniterra train STAGE --calibrate-spectrum` on counterparts of **training** tiles and
-//! stored as knots in the manifest; the kernel is built from them on load. It is isotropic,
-//! sums to one (the mean level is kept) and reads `radius` pixels beyond each output pixel,
-//! so over the infinite grid it is one global convolution: seamless and a pure function of
-//! the stage's output, like everything else in the engine.
-
-use std::sync::Arc;
+//! stored as knots in the manifest; the kernel is built from them on load. It is isotropic
+//! and sums to one (the mean level is kept).
+//!
+//! It filters each window's output, mirrored at the window's edges, before the engine blends
+//! the windows — not the blended field: a filter over the field would read `radius` pixels
+//! around every query, and for a cold 512-block region that is half as many network windows
+//! again. Near a window's edges the mirrored filter is not the global one, but there the
+//! tent weights are small, and the calibration measures (and its second pass corrects) the
+//! result as the engine blends it.
 
 use serde::{Deserialize, Serialize};
 
-use crate::infinite::{Engine, Source, WindowFn, WindowIndex, WindowLayout, Windowed};
 use crate::metrics::{fft2, Complex, Spectrum};
-use crate::tile::{Rect, Tile};
 
 /// Side of the frequency grid the kernel is designed on (a power of two; its finest ring is
 /// 2 pixels, its coarsest `KERNEL_GRID` pixels).
@@ -30,9 +31,6 @@ pub const MAX_RADIUS: usize = 64;
 /// Range of an amplitude gain: more than this either way is not a calibration but a
 /// different terrain.
 pub const GAIN_RANGE: (f64, f64) = (0.25, 4.0);
-/// Side of the equaliser's output windows (they do not overlap: each output pixel is one
-/// convolution, no blending).
-const WINDOW: i64 = 64;
 
 /// A stage's spectral correction, as its manifest stores it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -58,10 +56,12 @@ impl SpectralEqualiser {
         }
     }
 
-    /// Checks the manifest entry can be built into a kernel.
-    pub fn validate(&self) -> Result<(), String> {
-        if !(1..=MAX_RADIUS).contains(&self.radius) {
-            return Err(format!("spectral_equaliser.radius = {} (must be 1–{MAX_RADIUS} pixels)", self.radius));
+    /// Checks the manifest entry can be built into a kernel for windows of side `window`
+    /// (the mirror at a window's edge needs a radius under the window's side).
+    pub fn validate(&self, window: usize) -> Result<(), String> {
+        let max = MAX_RADIUS.min(window.saturating_sub(1));
+        if !(1..=max).contains(&self.radius) {
+            return Err(format!("spectral_equaliser.radius = {} (must be 1–{max} pixels)", self.radius));
         }
         let bad_knot = |&[l, g]: &[f64; 2]| !(l.is_finite() && l > 0.0 && (GAIN_RANGE.0..=GAIN_RANGE.1).contains(&g));
         if self.gains.is_empty() || self.gains.iter().any(bad_knot) || self.gains.windows(2).any(|w| w[1][0] >= w[0][0])
@@ -156,78 +156,53 @@ pub fn band_gain(real: &Spectrum, generated: &Spectrum, metres: f64, wavelength:
     (!band.is_empty()).then(|| (0.5 * band.iter().sum::<f64>() / band.len() as f64).exp())
 }
 
-/// A source passed through a [`SpectralEqualiser`], as a window function: each
-/// [`WINDOW`]² output window is the convolution of the source over the window and `radius`
-/// pixels around it.
-pub struct Equalised {
-    name: String,
-    source: Arc<dyn Source>,
-    kernel: Vec<f32>,
-    radius: i64,
+/// A [`SpectralEqualiser`] ready to run: its kernel, built once.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EqualiserKernel {
+    radius: usize,
+    weights: Vec<f32>,
 }
 
-impl Equalised {
-    /// `source` (one channel) filtered by `equaliser`; `name` labels the engine's counters.
-    pub fn new(name: &str, source: Arc<dyn Source>, equaliser: &SpectralEqualiser) -> Equalised {
-        Equalised {
-            name: format!("{name}.equaliser"),
-            source,
-            kernel: equaliser.kernel(),
-            radius: equaliser.radius as i64,
-        }
+impl EqualiserKernel {
+    /// The kernel of `equaliser`.
+    pub fn new(equaliser: &SpectralEqualiser) -> EqualiserKernel {
+        EqualiserKernel { radius: equaliser.radius, weights: equaliser.kernel() }
     }
 
-    fn window(&self, rect: Rect) -> Tile {
-        let r = self.radius;
-        let padded = Rect::new(rect.y0 - r, rect.x0 - r, rect.h + 2 * r, rect.w + 2 * r);
-        let src = self.source.query(padded);
-        let (pw, side) = (padded.w as usize, (2 * r + 1) as usize);
-        let mut out = Vec::with_capacity(rect.area());
-        for y in 0..rect.h as usize {
-            for x in 0..rect.w as usize {
+    /// One `side`² window (row-major) filtered, mirrored at its edges (edge pixels not
+    /// repeated). Panics unless the radius is under `side`.
+    pub fn apply(&self, values: &[f32], side: usize) -> Vec<f32> {
+        assert!(self.radius < side && values.len() == side * side, "a {side}² window and radius {}", self.radius);
+        let (r, k) = (self.radius as i64, 2 * self.radius + 1);
+        let last = side as i64 - 1;
+        let mirror = |i: i64| {
+            (if i < 0 {
+                -i
+            } else if i > last {
+                2 * last - i
+            } else {
+                i
+            }) as usize
+        };
+        let padded_side = side + 2 * self.radius;
+        let mut padded = Vec::with_capacity(padded_side * padded_side);
+        for y in -r..side as i64 + r {
+            let row = &values[mirror(y) * side..(mirror(y) + 1) * side];
+            padded.extend((-r..side as i64 + r).map(|x| row[mirror(x)]));
+        }
+        let mut out = Vec::with_capacity(side * side);
+        for y in 0..side {
+            for x in 0..side {
                 // Row by row in a fixed order: the same sum, bit for bit, wherever it runs.
                 let mut acc = 0.0f32;
-                for (ky, krow) in self.kernel.chunks_exact(side).enumerate() {
-                    let row = &src.data[(y + ky) * pw + x..(y + ky) * pw + x + side];
-                    acc += row.iter().zip(krow).map(|(a, b)| a * b).sum::<f32>();
+                for (ky, krow) in self.weights.chunks_exact(k).enumerate() {
+                    let start = (y + ky) * padded_side + x;
+                    acc += padded[start..start + k].iter().zip(krow).map(|(a, b)| a * b).sum::<f32>();
                 }
                 out.push(acc);
             }
         }
-        Tile::from_data(1, rect, out)
-    }
-}
-
-/// `source`, the output of stage `name`, as the engine serves it: through `equaliser` when
-/// there is one (behind the engine's cache), untouched otherwise.
-pub fn equalised(
-    engine: &Arc<Engine>,
-    name: &str,
-    source: Arc<dyn Source>,
-    equaliser: Option<&SpectralEqualiser>,
-) -> Arc<dyn Source> {
-    match equaliser {
-        Some(eq) => Windowed::new(engine, Equalised::new(name, source, eq)),
-        None => source,
-    }
-}
-
-impl WindowFn for Equalised {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn channels(&self) -> usize {
-        1
-    }
-
-    fn layout(&self) -> WindowLayout {
-        WindowLayout::square(WINDOW, WINDOW, 0)
-    }
-
-    fn eval(&self, windows: &[WindowIndex]) -> Vec<Tile> {
-        let layout = self.layout();
-        windows.iter().map(|&w| self.window(layout.rect(w))).collect()
+        out
     }
 }
 
@@ -235,6 +210,7 @@ impl WindowFn for Equalised {
 mod tests {
     use super::*;
     use crate::metrics::{radial_power_spectrum, Raster};
+    use std::f32::consts::TAU;
 
     fn flat(gains: Vec<[f64; 2]>) -> SpectralEqualiser {
         SpectralEqualiser { radius: 8, gains }
@@ -243,15 +219,19 @@ mod tests {
     #[test]
     fn the_gain_is_log_linear_between_knots_and_flat_beyond() {
         let eq = flat(vec![[64.0, 1.0], [16.0, 2.0], [4.0, 0.5]]);
-        eq.validate().expect("descending wavelengths, gains in range");
+        eq.validate(64).expect("descending wavelengths, gains in range");
         for (wavelength, want) in
             [(f64::INFINITY, 1.0), (128.0, 1.0), (32.0, 1.5), (16.0, 2.0), (8.0, 1.25), (2.0, 0.5)]
         {
             assert!((eq.gain(wavelength) - want).abs() < 1e-12, "gain({wavelength}) = {}", eq.gain(wavelength));
         }
-        assert!(flat(vec![[4.0, 1.0], [16.0, 1.0]]).validate().unwrap_err().contains("spectral_equaliser.gains"));
-        assert!(flat(vec![[16.0, 9.0]]).validate().unwrap_err().contains("gains within"));
-        assert!(SpectralEqualiser { radius: 0, ..eq }.validate().unwrap_err().contains("spectral_equaliser.radius"));
+        assert!(flat(vec![[4.0, 1.0], [16.0, 1.0]]).validate(64).unwrap_err().contains("spectral_equaliser.gains"));
+        assert!(flat(vec![[16.0, 9.0]]).validate(64).unwrap_err().contains("gains within"));
+        assert!(SpectralEqualiser { radius: 0, ..eq.clone() }
+            .validate(64)
+            .unwrap_err()
+            .contains("spectral_equaliser.radius"));
+        assert!(eq.validate(8).unwrap_err().contains("must be 1–7"), "the mirror needs a radius under the window");
     }
 
     #[test]
@@ -261,7 +241,8 @@ mod tests {
         assert!(
             (k[8 * 17 + 8] - 1.0).abs() < 1e-6 && k.iter().enumerate().all(|(i, v)| i == 8 * 17 + 8 || v.abs() < 1e-6)
         );
-        let k = flat(vec![[32.0, 1.0], [8.0, 0.5]]).kernel();
+        let eq = flat(vec![[32.0, 1.0], [8.0, 0.5]]);
+        let k = eq.kernel();
         assert!((k.iter().map(|&v| v as f64).sum::<f64>() - 1.0).abs() < 1e-5);
         // Isotropic and zero-phase: symmetric under flips and transposition.
         for y in 0..17 {
@@ -271,113 +252,60 @@ mod tests {
                 );
             }
         }
+        // A level window stays level, edges included (the mirror adds nothing).
+        let out = EqualiserKernel::new(&eq).apply(&[250.0; 32 * 32], 32);
+        assert!(out.iter().all(|v| (v - 250.0).abs() < 1e-2), "{:?}", &out[..4]);
     }
 
-    /// A field with equal power at 8 and 32 pixels, as a [`Source`].
-    struct Waves;
+    /// Two plane waves: `broad`× one of 32 pixels and `fine`× one of 8.
+    fn waves(side: usize, broad: f32, fine: f32) -> Vec<f32> {
+        (0..side * side)
+            .map(|i| {
+                let (y, x) = ((i / side) as f32, (i % side) as f32);
+                broad * (TAU * (x + 0.3 * y) / 32.0).sin() + fine * (TAU * (y - 0.2 * x) / 8.0).sin()
+            })
+            .collect()
+    }
 
-    impl Source for Waves {
-        fn channels(&self) -> usize {
-            1
+    /// Amplitude of the 32-pixel (`broad`) or the 8-pixel wave in the centre 64² of a
+    /// `side`² window: projection on the wave's own cosine and sine.
+    fn amplitude(v: &[f32], side: usize, broad: bool) -> f32 {
+        let (mut c, mut s, mut n) = (0.0f64, 0.0f64, 0.0f64);
+        let m = (side - 64) / 2;
+        for y in m..m + 64 {
+            for x in m..m + 64 {
+                let (yf, xf) = (y as f32, x as f32);
+                let phase = if broad { (xf + 0.3 * yf) / 32.0 } else { (yf - 0.2 * xf) / 8.0 };
+                c += (v[y * side + x] * (TAU * phase).cos()) as f64;
+                s += (v[y * side + x] * (TAU * phase).sin()) as f64;
+                n += 1.0;
+            }
         }
-        fn query(&self, rect: Rect) -> Tile {
-            let wave = |y: i64, x: i64| {
-                let (y, x) = (y as f32, x as f32);
-                (std::f32::consts::TAU * (x + 0.3 * y) / 32.0).sin()
-                    + (std::f32::consts::TAU * (y - 0.2 * x) / 8.0).sin()
-            };
-            let data = (rect.y0..rect.y1()).flat_map(|y| (rect.x0..rect.x1()).map(move |x| wave(y, x))).collect();
-            Tile::from_data(1, rect, data)
-        }
+        (c.hypot(s) * 2.0 / n) as f32
     }
 
     #[test]
     fn calibrated_gains_bring_a_misshapen_spectrum_to_the_real_one() {
         // Real: both waves at amplitude 1. Generated: the 32-pixel wave at half amplitude, the
         // 8-pixel one doubled — a network short at broad scales and rough at fine ones.
-        let real = Raster::from_fn(256, 256, 1000.0, |y, x| Waves.query(Rect::new(y as i64, x as i64, 1, 1)).data[0]);
-        let (a, b) = (0.5f32, 2.0f32);
-        let generated = Raster::from_fn(256, 256, 1000.0, |y, x| {
-            let (y, x) = (y as f32, x as f32);
-            a * (std::f32::consts::TAU * (x + 0.3 * y) / 32.0).sin()
-                + b * (std::f32::consts::TAU * (y - 0.2 * x) / 8.0).sin()
-        });
-        let (sr, sg) = (radial_power_spectrum(&real), radial_power_spectrum(&generated));
+        let raster = |v: Vec<f32>| Raster::new(256, 256, 1000.0, v);
+        let (sr, sg) = (
+            radial_power_spectrum(&raster(waves(256, 1.0, 1.0))),
+            radial_power_spectrum(&raster(waves(256, 0.5, 2.0))),
+        );
         let eq =
             SpectralEqualiser::from_spectra(&sr, &sg, 1000.0, 24, &[64.0, 32.0, 16.0, 8.0, 4.0]).expect("rings reach");
-        eq.validate().expect("calibrated gains are valid");
+        eq.validate(64).expect("calibrated gains are valid");
         assert_eq!(eq.gain(128.0), 1.0, "the longest wavelengths are left alone");
         assert!(eq.gain(32.0) > 1.5 && eq.gain(8.0) < 0.7, "{:?}", eq.gains);
-        // Filtered through the engine-facing window function, the fine wave loses amplitude
-        // and the broad one gains it.
+        // Applied to a window, the fine wave loses amplitude and the broad one gains it. A
+        // 32-pixel radius cannot resolve a one-octave peak fully (the taper smooths the gain by
+        // about a quarter octave), so the broad wave gets most of its ×2, not all of it.
         let boost = SpectralEqualiser { radius: 32, gains: vec![[64.0, 1.0], [32.0, 2.0], [16.0, 1.0], [8.0, 0.5]] };
-        let filtered = Equalised::new("test", Arc::new(Waves), &boost);
-        let out = filtered.eval(&[WindowIndex { iy: 0, ix: 0 }, WindowIndex { iy: 1, ix: 0 }]);
-        let input = Waves.query(Rect::new(0, 0, 64, 64));
-        let amplitude = |t: &[f32], period: f32| {
-            // Projection on the wave's own cosine and sine.
-            let (mut c, mut s) = (0.0f64, 0.0f64);
-            for (i, v) in t.iter().enumerate() {
-                let (y, x) = ((i / 64) as f32, (i % 64) as f32);
-                let phase = if period > 16.0 { (x + 0.3 * y) / period } else { (y - 0.2 * x) / period };
-                c += (*v * (std::f32::consts::TAU * phase).cos()) as f64;
-                s += (*v * (std::f32::consts::TAU * phase).sin()) as f64;
-            }
-            (c.hypot(s) * 2.0 / t.len() as f64) as f32
-        };
-        let (broad, fine) = (
-            amplitude(&out[0].data, 32.0) / amplitude(&input.data, 32.0),
-            amplitude(&out[0].data, 8.0) / amplitude(&input.data, 8.0),
-        );
-        // A 32-pixel radius cannot resolve a one-octave peak fully (the taper smooths the gain
-        // by about a quarter octave), so the broad wave gets most of its ×2, not all of it.
+        let input = waves(128, 1.0, 1.0);
+        let out = EqualiserKernel::new(&boost).apply(&input, 128);
+        let broad = amplitude(&out, 128, true) / amplitude(&input, 128, true);
+        let fine = amplitude(&out, 128, false) / amplitude(&input, 128, false);
         assert!((1.25..2.1).contains(&broad) && (0.4..0.6).contains(&fine), "broad ×{broad}, fine ×{fine}");
-        // Windows tile the plane without overlap: the second starts where the first ends.
-        assert_eq!(out[1].rect, Rect::new(64, 0, 64, 64));
-    }
-
-    #[test]
-    fn through_the_engine_it_is_one_global_convolution_whatever_the_threads_and_order() {
-        use crate::infinite::EngineConfig;
-        let eq = SpectralEqualiser { radius: 6, gains: vec![[32.0, 1.0], [16.0, 1.5], [4.0, 0.7]] };
-        let kernel = eq.kernel();
-        // A region straddling four 64² output windows, off the window grid.
-        let region = Rect::new(-70, 30, 100, 90);
-        let direct: Vec<f32> = {
-            let src = Waves.query(region.pad(6));
-            let pw = (region.w + 12) as usize;
-            (0..region.area())
-                .map(|i| {
-                    let (y, x) = (i / region.w as usize, i % region.w as usize);
-                    let mut acc = 0.0f32;
-                    for ky in 0..13 {
-                        let row = &src.data[(y + ky) * pw + x..(y + ky) * pw + x + 13];
-                        acc += row.iter().zip(&kernel[ky * 13..ky * 13 + 13]).map(|(a, b)| a * b).sum::<f32>();
-                    }
-                    acc
-                })
-                .collect()
-        };
-        let source = |threads: usize| {
-            let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads });
-            equalised(&engine, "test", Arc::new(Waves), Some(&eq))
-        };
-        let whole = source(1).query(region);
-        let max_err = whole.data.iter().zip(&direct).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-        assert!(max_err < 1e-4, "windowed vs direct convolution differ by {max_err}");
-        let two = source(2);
-        for (qy, qx) in [(1, 1), (0, 0), (1, 0), (0, 1)] {
-            let quarter = Rect::new(region.y0 + qy * 50, region.x0 + qx * 45, 50, 45);
-            assert!(
-                two.query(quarter) == whole.crop(quarter),
-                "{quarter:?}: 2 threads, out of order, not bit-identical"
-            );
-        }
-        assert!(
-            equalised(&Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 }), "x", Arc::new(Waves), None)
-                .query(region)
-                .data
-                == Waves.query(region).data
-        );
     }
 }

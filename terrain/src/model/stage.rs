@@ -7,12 +7,14 @@
 //! the same values where windows overlap. Its noise comes from
 //! [`GaussianNoise`] keyed by (seed, stage, sampler step, global tile), so the result is a pure
 //! function of (seed, region). The whole few-step sampler runs inside each window (T = 1
-//! blending step); overlapping outputs are blended by the engine's tent weights.
+//! blending step); each window's output passes the manifest's spectral equaliser, if any;
+//! overlapping outputs are blended by the engine's tent weights.
 
 use std::sync::Arc;
 
 use burn::tensor::{Device, Tensor, TensorData};
 
+use super::equaliser::EqualiserKernel;
 use super::store::{LoadedModel, Normalisation};
 use super::{Guidance, Guide, ReliefHint, Sampler, UNet};
 use crate::encoding::{blur, signed_sqrt, signed_square, ContextSpec};
@@ -44,6 +46,7 @@ pub struct LearnedStage {
     sampler: Sampler,
     norm: Normalisation,
     hint: Option<ReliefHint>,
+    equaliser: Option<EqualiserKernel>,
     spec: ContextSpec,
     coarse: Arc<dyn Source>,
     seed: u64,
@@ -64,6 +67,7 @@ impl LearnedStage {
             sampler: model.manifest.sampler.clone(),
             norm: model.manifest.normalisation.clone(),
             hint: model.manifest.relief_hint.clone(),
+            equaliser: model.manifest.spectral_equaliser.as_ref().map(EqualiserKernel::new),
             spec: model.manifest.context,
             guide: model.guide.zip(model.manifest.guidance.clone()),
             net: model.net,
@@ -175,8 +179,12 @@ impl WindowFn for LearnedStage {
             .enumerate()
             .map(|(i, (&r, low))| {
                 let residual = &values[i * n..(i + 1) * n];
-                let metres =
+                let metres: Vec<f32> =
                     low.iter().zip(residual).map(|(&l, &x)| signed_square(l + x * self.norm.target_scale)).collect();
+                let metres = match &self.equaliser {
+                    Some(kernel) => kernel.apply(&metres, side),
+                    None => metres,
+                };
                 Tile::from_data(1, r, metres)
             })
             .collect()

@@ -353,7 +353,7 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
         hint.validate().map_err(manifest_corrupt)?;
     }
     if let Some(eq) = &manifest.spectral_equaliser {
-        eq.validate().map_err(manifest_corrupt)?;
+        eq.validate(manifest.window).map_err(manifest_corrupt)?;
     }
     if !(manifest.metres_per_pixel.is_finite() && manifest.metres_per_pixel > 0.0) {
         return Err(manifest_corrupt(format!("metres_per_pixel = {} (must be positive)", manifest.metres_per_pixel)));

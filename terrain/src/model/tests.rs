@@ -5,7 +5,7 @@ use burn::tensor::{Device, Tensor, TensorData};
 
 use super::stage::LearnedStage;
 use super::*;
-use crate::infinite::{Engine, EngineConfig, Source, Windowed};
+use crate::infinite::{Engine, EngineConfig, Source, WindowFn, WindowIndex, Windowed};
 use crate::tile::{Rect, Tile};
 
 fn device() -> Device {
@@ -355,11 +355,16 @@ impl Source for Hills {
 }
 
 fn tiny_core(batch: usize) -> LearnedStage {
+    tiny_core_with(batch, None)
+}
+
+fn tiny_core_with(batch: usize, equaliser: Option<SpectralEqualiser>) -> LearnedStage {
     let net = perturbed_tiny(11);
     let mut manifest = manifest_for(&net);
     manifest.window = 32;
     manifest.normalisation =
         Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+    manifest.spectral_equaliser = equaliser;
     LearnedStage::new(LoadedModel { net, manifest, guide: None }, device(), Arc::new(Hills), 42, batch)
 }
 
@@ -585,4 +590,44 @@ fn a_sample_denoises_to_the_same_bits_whatever_batch_it_is_in() {
             "sample {i} alone differs from sample {i} in a batch of 3"
         );
     }
+}
+
+#[test]
+fn the_spectral_equaliser_filters_each_window_before_the_blend_and_is_checked_on_load() {
+    use super::equaliser::EqualiserKernel;
+    let eq = SpectralEqualiser { radius: 6, gains: vec![[32.0, 1.0], [16.0, 1.4], [4.0, 0.6]] };
+    let windows = [WindowIndex { iy: -1, ix: 2 }, WindowIndex { iy: 0, ix: 0 }];
+    let plain = tiny_core(2).eval(&windows);
+    let filtered = tiny_core_with(2, Some(eq.clone())).eval(&windows);
+    let kernel = EqualiserKernel::new(&eq);
+    for (p, f) in plain.iter().zip(&filtered) {
+        assert_eq!(f.rect, p.rect);
+        assert!(f.data == kernel.apply(&p.data, 32), "window {:?} is not its network output, filtered", f.rect);
+        assert_ne!(f.data, p.data);
+    }
+    // Through the engine it stays a pure function of the region: other batch, other thread
+    // count, piecewise queries.
+    let region = Rect::new(-40, 25, 48, 40);
+    let whole = Windowed::new(
+        &Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 }),
+        tiny_core_with(4, Some(eq.clone())),
+    )
+    .query(region);
+    let tensor = Windowed::new(
+        &Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 }),
+        tiny_core_with(3, Some(eq.clone())),
+    );
+    let part = tensor.query(Rect::new(-20, 40, 16, 16));
+    assert_eq!(whole.crop(part.rect), part);
+
+    // A radius the 32-pixel windows cannot mirror is refused on load, naming the entry.
+    let dir = tempdir("equaliser");
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    manifest.spectral_equaliser = Some(SpectralEqualiser { radius: 40, ..eq });
+    save_model(&dir, &net, manifest, Precision::F32).expect("save");
+    let msg = load_model(&dir, "test", &device()).expect_err("radius past the window").to_string();
+    assert!(msg.contains("test.json") && msg.contains("spectral_equaliser.radius"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

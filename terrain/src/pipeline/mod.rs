@@ -368,9 +368,7 @@ fn learned_stage(
         1 => context,
         factor => Arc::new(BoxMean { source: context, factor }),
     };
-    let equaliser = model.manifest.spectral_equaliser.clone();
-    let network = Windowed::new(engine, LearnedStage::new(model, device, context, seed, 8));
-    let source = crate::model::equaliser::equalised(engine, name, network, equaliser.as_ref());
+    let source = Windowed::new(engine, LearnedStage::new(model, device, context, seed, 8));
     for s in stages.iter_mut().filter(|s| s.name == name) {
         s.state = StageState::Active;
     }
