@@ -3,8 +3,9 @@
 //! The shipped model (its relief hint and response curve as they are, its old equaliser
 //! off) generates counterparts of real **training** tiles; the mean radial power spectra of
 //! the real and the generated tiles give, per wavelength, the amplitude gain √(real /
-//! generated) that [`SpectralEqualiser`] applies. A second pass with the equaliser on shows
-//! what it changed. Run it after the response curve: the curve sets how much relief each
+//! generated) that [`SpectralEqualiser`] applies. A pass with the equaliser on measures what
+//! the kernel left and refines the gains; a last pass shows the result. Run it after the
+//! response curve: the curve sets how much relief each
 //! window gets, the equaliser only how it is shared out over wavelengths.
 
 use std::path::Path;
@@ -37,16 +38,34 @@ fn raster(size: usize, metres: f64, values: Vec<f32>) -> Raster {
     Raster::new(size, size, metres, values)
 }
 
-/// The mean spectrum of `model`'s counterparts of `tiles` (seeds `seed`, `seed + 1`, …).
-fn generated_spectrum(model: &LoadedModel, device: &Device, tiles: &[&EncodedTile], seed: u64) -> Option<Spectrum> {
+/// The mean spectrum of `model`'s counterparts of `tiles` (seeds `seed`, `seed + 1`, …), with
+/// a progress line (`what`, tiles done, rate, ETA) on stderr.
+fn generated_spectrum(
+    model: &LoadedModel,
+    device: &Device,
+    tiles: &[&EncodedTile],
+    seed: u64,
+    what: &str,
+) -> Option<Spectrum> {
     let metres = model.manifest.metres_per_pixel;
+    let started = Instant::now();
     let spectra: Vec<Spectrum> = tiles
         .iter()
         .enumerate()
         .map(|(i, t)| {
-            radial_power_spectrum(&raster(t.size, metres, counterpart(model, device, &t.h, t.size, seed + i as u64).0))
+            let generated = counterpart(model, device, &t.h, t.size, seed + i as u64).0;
+            let secs = started.elapsed().as_secs_f64();
+            let left = (tiles.len() - i - 1) as f64 * secs / (i + 1) as f64;
+            eprint!(
+                "\r  {what}: tile {}/{} ({:.2} tiles/s, ETA {left:.0} s)   ",
+                i + 1,
+                tiles.len(),
+                (i + 1) as f64 / secs
+            );
+            radial_power_spectrum(&raster(t.size, metres, generated))
         })
         .collect();
+    eprintln!();
     Spectrum::mean(&spectra)
 }
 
@@ -85,7 +104,8 @@ pub fn run(
         .collect();
     let real = Spectrum::mean(&real).ok_or_else(|| anyhow!("{}: no training tiles of one size", data.display()))?;
     let started = Instant::now();
-    let before = generated_spectrum(&model, &device, &tiles, seed).ok_or_else(|| anyhow!("no counterparts"))?;
+    let before = generated_spectrum(&model, &device, &tiles, seed, "without an equaliser")
+        .ok_or_else(|| anyhow!("no counterparts"))?;
     eprintln!(
         "calibrate {stage}: {} training tiles generated without an equaliser ({:.0} s): β {:.3} (real {:.3}); generated/real amplitude {}",
         tiles.len(),
@@ -102,7 +122,8 @@ pub fn run(
         eq.validate(model.manifest.window)
             .map_err(|e| anyhow!("the measured gains are out of range ({e}): is this model trained?"))?;
         model.manifest.spectral_equaliser = Some(eq.clone());
-        let after = generated_spectrum(&model, &device, &tiles, seed).ok_or_else(|| anyhow!("no counterparts"))?;
+        let after = generated_spectrum(&model, &device, &tiles, seed, &format!("pass {pass}/{PASSES}"))
+            .ok_or_else(|| anyhow!("no counterparts"))?;
         eprintln!(
             "calibrate {stage}: pass {pass}/{PASSES} with the equaliser ({:.0} s): β {:.3} (real {:.3}); generated/real amplitude {}",
             started.elapsed().as_secs_f64(),
