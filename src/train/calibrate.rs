@@ -84,7 +84,8 @@ pub(super) fn spread(tiles: &[EncodedTile], count: usize, phase: f64) -> Vec<&En
     (0..count.min(tiles.len())).map(|i| &tiles[(((i as f64 + phase) * step) as usize).min(tiles.len() - 1)]).collect()
 }
 
-fn raster(tile: &EncodedTile, metres: f64) -> Raster {
+/// A real tile as elevations in metres.
+pub(super) fn raster(tile: &EncodedTile, metres: f64) -> Raster {
     Raster::new(tile.size, tile.size, metres, tile.h.iter().map(|&v| signed_square(v)).collect())
 }
 

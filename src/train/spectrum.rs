@@ -12,13 +12,12 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::anyhow;
-use infiniterra_terrain::encoding::signed_square;
 use infiniterra_terrain::metrics::{fit_beta, radial_power_spectrum, Raster, Spectrum};
 use infiniterra_terrain::model::burn::tensor::Device;
 use infiniterra_terrain::model::equaliser::band_gain;
 use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel, SpectralEqualiser};
 
-use super::calibrate::spread;
+use super::calibrate::{raster as real_raster, spread};
 use super::data::{read_split, EncodedTile};
 use super::heldout::counterpart;
 
@@ -98,10 +97,7 @@ pub fn run(
     let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
     let metres = model.manifest.metres_per_pixel;
-    let real: Vec<Spectrum> = tiles
-        .iter()
-        .map(|t| radial_power_spectrum(&raster(t.size, metres, t.h.iter().map(|&v| signed_square(v)).collect())))
-        .collect();
+    let real: Vec<Spectrum> = tiles.iter().map(|t| radial_power_spectrum(&real_raster(t, metres))).collect();
     let real = Spectrum::mean(&real).ok_or_else(|| anyhow!("{}: no training tiles of one size", data.display()))?;
     let started = Instant::now();
     let before = generated_spectrum(&model, &device, &tiles, seed, "without an equaliser")
