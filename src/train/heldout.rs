@@ -108,13 +108,23 @@ pub fn compare(
     Ok(())
 }
 
-/// Writes `count` generated tiles (seeds `seed`, `seed + 1`, …) to `out` (+ `out.json`).
+/// Seed distance between two draws of the same tile: draw `d` of tile `i` uses seed
+/// `seed + d·DRAW_SEED_STRIDE + i`, so draw 0 is the single-draw set and `--seed 1000` gives
+/// draw 1 on its own.
+pub const DRAW_SEED_STRIDE: u64 = 1000;
+
+/// Writes `draws` generated counterparts of each of the first `count` held-out tiles to `out`
+/// (+ `out.json`), stacked draw by draw (draw 0's tiles first). One draw of a stochastic model
+/// is one sample of its output: on 104 tiles the spectral slope alone scatters by ±0.02 from
+/// draw to draw, so the realism bar is best measured on a few draws of every tile.
+#[allow(clippy::too_many_arguments)] // the CLI's flags, passed through one by one
 pub fn generate(
     models: &Path,
     stage: &str,
     data: &Path,
     out: &Path,
     count: usize,
+    draws: usize,
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
@@ -122,32 +132,55 @@ pub fn generate(
     let model = load_model(models, stage, &device)?;
     let heldout = read_split(&data.join(stage), "heldout", 1, model.manifest.context).map_err(anyhow::Error::msg)?;
     let count = count.min(heldout.tiles.len());
+    let draws = draws.max(1);
+    if draws > 1 && count as u64 > DRAW_SEED_STRIDE {
+        anyhow::bail!(
+            "--draws {draws} needs --tiles ≤ {DRAW_SEED_STRIDE} (each draw's seeds start {DRAW_SEED_STRIDE} apart)"
+        );
+    }
     let mut stack = Vec::new();
     let started = Instant::now();
     let mut windows = 0;
-    for (i, tile) in heldout.tiles.iter().take(count).enumerate() {
-        let (data, w) = counterpart(&model, &device, &tile.h, tile.size, seed + i as u64);
-        windows += w;
-        stack.extend_from_slice(&data);
-        eprintln!("generated held-out tile {}/{count} ({:.1} s so far)", i + 1, started.elapsed().as_secs_f64());
+    let total = count * draws;
+    for draw in 0..draws {
+        for (i, tile) in heldout.tiles.iter().take(count).enumerate() {
+            let tile_seed = seed + draw as u64 * DRAW_SEED_STRIDE + i as u64;
+            let (data, w) = counterpart(&model, &device, &tile.h, tile.size, tile_seed);
+            windows += w;
+            stack.extend_from_slice(&data);
+            let done = draw * count + i + 1;
+            let secs = started.elapsed().as_secs_f64();
+            eprint!(
+                "\rgenerated held-out tile {}/{count}, draw {}/{draws} ({:.2} tiles/s, ETA {:.0} s)   ",
+                i + 1,
+                draw + 1,
+                done as f64 / secs,
+                (total - done) as f64 * secs / done as f64
+            );
+        }
     }
+    eprintln!();
     let secs = started.elapsed().as_secs_f64();
     let size = heldout.tiles.first().map_or(0, |t| t.size);
-    write_npy_f32(out, (count * size, size), &stack).with_context(|| format!("writing {}", out.display()))?;
+    write_npy_f32(out, (total * size, size), &stack).with_context(|| format!("writing {}", out.display()))?;
     let side = serde_json::json!({
         "metres_per_pixel": model.manifest.metres_per_pixel,
         "tile": size,
-        "count": count,
+        "count": total,
         "heldout_counterparts": count,
+        "draws": draws,
         "stage": stage,
-        "generator": format!("infiniterra train {stage} --generate-heldout (conditioned on each held-out tile's low band)"),
+        "generator": format!(
+            "infiniterra train {stage} --generate-heldout --draws {draws} (conditioned on each held-out tile's low band; \
+             draw d of tile i uses seed {seed} + {DRAW_SEED_STRIDE}·d + i)"
+        ),
         "seed": seed,
     });
     let json = out.with_extension("json");
     std::fs::write(&json, serde_json::to_string_pretty(&side)?)
         .with_context(|| format!("writing {}", json.display()))?;
     println!(
-        "wrote {} ({count} tiles of {size}², {windows} windows in {secs:.1} s = {:.1} windows/s) and {}",
+        "wrote {} ({count} tiles × {draws} draws of {size}², {windows} windows in {secs:.1} s = {:.1} windows/s) and {}",
         out.display(),
         windows as f64 / secs,
         json.display()

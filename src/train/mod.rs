@@ -109,6 +109,10 @@ pub struct TrainArgs {
     /// Instead of training, generate held-out counterparts into this `.npy` (see `--tiles`).
     #[arg(long)]
     pub generate_heldout: Option<PathBuf>,
+    /// With `--generate-heldout`: counterparts of each tile, each drawn with its own noise
+    /// (the realism bar of a stochastic model is measured on several draws, not one).
+    #[arg(long, default_value_t = 1)]
+    pub draws: usize,
     /// Instead of training: generate the counterpart of this real square region (`.npy` at the
     /// model's resolution, e.g. from `scripts/data/region.py`) and draw both side by side to
     /// `--picture`.
@@ -325,7 +329,7 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     }
     if let Some(out) = &args.generate_heldout {
         let seed = seed.unwrap_or(DEFAULT_SEED);
-        return heldout::generate(&args.out, &args.stage, &args.data, out, args.tiles, seed, args.backend)
+        return heldout::generate(&args.out, &args.stage, &args.data, out, args.tiles, args.draws, seed, args.backend)
             .map_err(Failure::runtime);
     }
     if args.fit_relief_hint {

@@ -25,6 +25,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         backend: ComputeBackend::Cpu,
         tiles: 0,
         generate_heldout: None,
+        draws: 1,
         counterpart: None,
         fit_relief_hint: false,
         calibrate_relief_hint: false,
@@ -284,5 +285,32 @@ fn calibrating_the_spectrum_writes_a_loadable_equaliser_measured_without_the_old
     infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).expect("loads");
     spectrum::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates again");
     assert_eq!(read()["spectral_equaliser"], first["spectral_equaliser"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn held_out_draws_stack_draw_by_draw_and_draw_one_is_the_next_seed_block() {
+    let (dir, data_dir, stack) = smoke_core_with_training_tiles("draws", 2);
+    let heldout_npy = data_dir.join("core/heldout.npy");
+    crate::export::write_npy_f32(&heldout_npy, (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack).expect("write");
+    let generate = |name: &str, draws: usize, seed: u64| {
+        let out = dir.join(name);
+        heldout::generate(&dir, "core", &data_dir, &out, 2, draws, seed, ComputeBackend::Cpu).expect("generates");
+        let side: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).expect("sidecar")).expect("JSON");
+        (crate::export::read_npy_f32(&out).expect("npy"), side)
+    };
+    let (((rows, cols), two), side) = generate("two.npy", 2, 7);
+    let n = data::PREPARED_TILE * data::PREPARED_TILE;
+    assert_eq!((rows, cols), (4 * data::PREPARED_TILE, data::PREPARED_TILE), "2 tiles × 2 draws");
+    assert_eq!(
+        (side["count"].as_u64(), side["heldout_counterparts"].as_u64(), side["draws"].as_u64()),
+        (Some(4), Some(2), Some(2))
+    );
+    let (((_, _), first), _) = generate("first.npy", 1, 7);
+    let (((_, _), second), _) = generate("second.npy", 1, 7 + heldout::DRAW_SEED_STRIDE);
+    assert_eq!(&two[..2 * n], &first[..], "draw 0 is the single-draw set");
+    assert_eq!(&two[2 * n..], &second[..], "draw 1 is the set of the next seed block");
+    assert_ne!(&two[..n], &two[2 * n..3 * n], "two draws of a tile differ");
     let _ = std::fs::remove_dir_all(&dir);
 }
