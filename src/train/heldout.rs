@@ -132,7 +132,9 @@ pub fn generate(
     let model = load_model(models, stage, &device)?;
     let heldout = read_split(&data.join(stage), "heldout", 1, model.manifest.context).map_err(anyhow::Error::msg)?;
     let count = count.min(heldout.tiles.len());
-    let draws = draws.max(1);
+    if draws == 0 {
+        anyhow::bail!("--draws 0: at least one draw of each tile is needed");
+    }
     if draws > 1 && count as u64 > DRAW_SEED_STRIDE {
         anyhow::bail!(
             "--draws {draws} needs --tiles ≤ {DRAW_SEED_STRIDE} (each draw's seeds start {DRAW_SEED_STRIDE} apart)"
