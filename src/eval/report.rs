@@ -100,6 +100,16 @@ fn targets(columns: &[Column], slope_edges: &[f64], relief_edges: &[f64]) -> Vec
         (real / 2.0, real * 2.0),
         format!("within 2× of real {real:.2}"),
     ));
+    // DESIGN §3's second drainage number. Like the depression density it is a per-area amount
+    // dominated by a few tiles' large basins, so it gets the same rule (the real-vs-real
+    // distance, a few per cent on ~100 tiles, would be a line no region of real land meets).
+    let real = reference.depressions.volume_per_km2();
+    out.push(Target::new(
+        "fill_volume_per_km2",
+        generated.depressions.volume_per_km2(),
+        (real / 2.0, real * 2.0),
+        format!("within 2× of real {real:.0}"),
+    ));
     out.push(Target::new("seam_ratio", generated.seams.ratio(), (0.9, 1.1), "0.9–1.1".into()));
     out
 }

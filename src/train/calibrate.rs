@@ -32,7 +32,7 @@ pub(super) const REFINE: f64 = 0.1;
 
 /// How far a generated set is from the bar, averaged over its metrics: each distance in
 /// units of the bar's fBm line (distance / (fBm's distance / 5): 1 on the line), the
-/// depression density as |log₂(generated / real)| (1 at the "within 2×" edge). Below 1 on
+/// depression density and fill volume as |log₂(generated / real)| (1 at the "within 2×" edge). Below 1 on
 /// every metric means those lines are met. The real-vs-real floor is left out on purpose: on
 /// a few dozen tiles it can be near zero by chance, and dividing by it turns noise into the
 /// score. Seams do not depend on the offset and are left out too.
@@ -41,7 +41,9 @@ pub fn score(targets: &[Target]) -> f64 {
         .iter()
         .filter_map(|t| match (t.key.as_str(), t.fbm) {
             ("seam_ratio", _) => None,
-            ("depressions_per_1000_km2", _) => Some((t.value / (t.low * t.high).sqrt()).log2().abs()),
+            ("depressions_per_1000_km2" | "fill_volume_per_km2", _) => {
+                Some((t.value / (t.low * t.high).sqrt()).log2().abs())
+            }
             (_, Some(fbm)) => Some(t.value / (fbm / 5.0).max(f64::MIN_POSITIVE)),
             (_, None) => None,
         })
@@ -104,9 +106,10 @@ pub(super) struct Hinted {
 pub(super) fn load_hinted(models: &Path, stage: &str, data: &Path, backend: ComputeBackend) -> anyhow::Result<Hinted> {
     let device = backend.device()?;
     let mut model = load_model(models, stage, &device)?;
-    // Both calibrations measure the network's own answer: the equaliser is calibrated on it
-    // afterwards.
+    // Both calibrations measure the network's own answer: the equaliser and the infill are
+    // calibrated on it afterwards.
     model.manifest.spectral_equaliser = None;
+    model.manifest.depression_infill = None;
     let path = models.join(format!("{stage}.json"));
     let Some(hint) = model.manifest.relief_hint.clone() else {
         anyhow::bail!(
@@ -227,9 +230,11 @@ mod tests {
         let on_the_lines = [
             target("slope_w1_deg", 0.2, 0.0, 0.2, Some(1.0)),
             target("depressions_per_1000_km2", 20.0, 5.0, 20.0, None),
+            target("fill_volume_per_km2", 1e6, 1e6, 4e6, None),
             target("seam_ratio", 3.0, 0.9, 1.1, None),
         ];
-        // Distance at fBm / 5: 1; depressions 2× real: |log₂ 2| = 1; seams ignored.
+        // Distance at fBm / 5: 1; depressions 2× real and fill volume ½ real: |log₂ 2| = 1;
+        // seams ignored.
         assert!((score(&on_the_lines) - 1.0).abs() < 1e-12);
         let better = [
             target("slope_w1_deg", 0.1, 0.0, 0.2, Some(1.0)),

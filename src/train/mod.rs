@@ -14,6 +14,7 @@ mod calibrate;
 pub mod data;
 mod ema;
 mod heldout;
+mod infill;
 mod preview;
 mod response;
 mod spectrum;
@@ -141,6 +142,12 @@ pub struct TrainArgs {
     /// `--calibrate-relief-response`.
     #[arg(long)]
     pub calibrate_spectrum: bool,
+    /// Instead of training: generate `--tiles` training tiles with the shipped
+    /// `<out>/<stage>.json`'s depression infill off and at depth scales from 160 m down, score
+    /// each set with the realism bar, and write the best into that manifest. Run it after
+    /// `--calibrate-spectrum`.
+    #[arg(long)]
+    pub calibrate_infill: bool,
     /// Train the stage's network at half the width (≈ ¼ of its cost per pixel). Trained
     /// briefly into its own `--out`, it is the shipped model's autoguidance guide: a "bad
     /// version of itself" whose errors guidance steers away from (`guide` in the manifest).
@@ -343,6 +350,11 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
     if args.calibrate_spectrum {
         let seed = seed.unwrap_or(DEFAULT_SEED);
         return spectrum::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
+            .map_err(Failure::runtime);
+    }
+    if args.calibrate_infill {
+        let seed = seed.unwrap_or(DEFAULT_SEED);
+        return infill::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
             .map_err(Failure::runtime);
     }
     if args.calibrate_relief_hint {

@@ -94,6 +94,8 @@ pub fn run(
     let mut model = load_model(models, stage, &device)?;
     let path = models.join(format!("{stage}.json"));
     model.manifest.spectral_equaliser = None;
+    // The infill comes after the equaliser in each window and is calibrated on its output.
+    model.manifest.depression_infill = None;
     let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
     let metres = model.manifest.metres_per_pixel;

@@ -31,6 +31,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         calibrate_relief_hint: false,
         calibrate_relief_response: false,
         calibrate_spectrum: false,
+        calibrate_infill: false,
         picture: PathBuf::from("unused.png"),
         half_width: false,
         smoke: true,
@@ -285,6 +286,31 @@ fn calibrating_the_spectrum_writes_a_loadable_equaliser_measured_without_the_old
     infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).expect("loads");
     spectrum::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates again");
     assert_eq!(read()["spectral_equaliser"], first["spectral_equaliser"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn calibrating_the_infill_writes_one_of_its_depth_scales_or_none_and_nothing_else() {
+    let (dir, data_dir, _) = smoke_core_with_training_tiles("infill", 4);
+    let read = || -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("core.json")).expect("manifest")).expect("JSON")
+    };
+    let before = read();
+    infill::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+    let first = read();
+    if let Some(entry) = first.get("depression_infill") {
+        let infill: infiniterra_terrain::model::DepressionInfill =
+            serde_json::from_value(entry.clone()).expect("a loadable entry");
+        assert!(infill::DEPTH_SCALES_M.contains(&infill.depth_scale_m), "{infill:?} was not tried");
+    }
+    let mut rest = first.clone();
+    rest.as_object_mut().expect("object").remove("depression_infill");
+    assert_eq!(rest, before, "nothing but the infill changed");
+    infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).expect("loads");
+    // Every trial sets the infill itself, so the entry the first run wrote does not change
+    // what a second run measures.
+    infill::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates again");
+    assert_eq!(read(), first);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -7,14 +7,15 @@
 //! the same values where windows overlap. Its noise comes from
 //! [`GaussianNoise`] keyed by (seed, stage, sampler step, global tile), so the result is a pure
 //! function of (seed, region). The whole few-step sampler runs inside each window (T = 1
-//! blending step); each window's output passes the manifest's spectral equaliser, if any;
-//! overlapping outputs are blended by the engine's tent weights.
+//! blending step); each window's output passes the manifest's spectral equaliser and then its
+//! depression infill, if any; overlapping outputs are blended by the engine's tent weights.
 
 use std::sync::Arc;
 
 use burn::tensor::{Device, Tensor, TensorData};
 
 use super::equaliser::EqualiserKernel;
+use super::infill::DepressionInfill;
 use super::store::{LoadedModel, Normalisation};
 use super::{Guidance, Guide, ReliefHint, Sampler, UNet};
 use crate::encoding::{blur, signed_sqrt, signed_square, ContextSpec};
@@ -47,6 +48,7 @@ pub struct LearnedStage {
     norm: Normalisation,
     hint: Option<ReliefHint>,
     equaliser: Option<EqualiserKernel>,
+    infill: Option<DepressionInfill>,
     spec: ContextSpec,
     coarse: Arc<dyn Source>,
     seed: u64,
@@ -68,6 +70,7 @@ impl LearnedStage {
             norm: model.manifest.normalisation.clone(),
             hint: model.manifest.relief_hint.clone(),
             equaliser: model.manifest.spectral_equaliser.as_ref().map(EqualiserKernel::new),
+            infill: model.manifest.depression_infill.clone(),
             spec: model.manifest.context,
             guide: model.guide.zip(model.manifest.guidance.clone()),
             net: model.net,
@@ -183,6 +186,10 @@ impl WindowFn for LearnedStage {
                     low.iter().zip(residual).map(|(&l, &x)| signed_square(l + x * self.norm.target_scale)).collect();
                 let metres = match &self.equaliser {
                     Some(kernel) => kernel.apply(&metres, side),
+                    None => metres,
+                };
+                let metres = match &self.infill {
+                    Some(infill) => infill.apply(&metres, side),
                     None => metres,
                 };
                 Tile::from_data(1, r, metres)

@@ -17,6 +17,7 @@ use sha2::{Digest, Sha256};
 
 use super::equaliser::SpectralEqualiser;
 use super::hint::ReliefHint;
+use super::infill::DepressionInfill;
 use super::sampler::Sampler;
 use super::unet::{UNet, UNetConfig};
 use crate::encoding::ContextSpec;
@@ -140,6 +141,10 @@ pub struct ModelManifest {
     /// output as the network draws it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectral_equaliser: Option<SpectralEqualiser>,
+    /// Sediment infill of closed basins in each window's output, after the equaliser (none:
+    /// basins as the network draws them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depression_infill: Option<DepressionInfill>,
     /// The sampler to run it with.
     pub sampler: Sampler,
     /// Autoguidance by a weaker model of the same stage (none: the model runs alone).
@@ -189,6 +194,7 @@ impl ModelManifest {
             normalisation: Normalisation::default(),
             relief_hint: None,
             spectral_equaliser: None,
+            depression_infill: None,
             sampler,
             guidance: None,
             training: TrainingRecord::default(),
@@ -354,6 +360,9 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
     }
     if let Some(eq) = &manifest.spectral_equaliser {
         eq.validate(manifest.window).map_err(manifest_corrupt)?;
+    }
+    if let Some(infill) = &manifest.depression_infill {
+        infill.validate().map_err(manifest_corrupt)?;
     }
     if !(manifest.metres_per_pixel.is_finite() && manifest.metres_per_pixel > 0.0) {
         return Err(manifest_corrupt(format!("metres_per_pixel = {} (must be positive)", manifest.metres_per_pixel)));

@@ -1,0 +1,119 @@
+//! Calibrating a stage's depression infill on training tiles.
+//!
+//! The shipped model (relief hint, response curve and spectral equaliser as they are)
+//! generates counterparts of real **training** tiles with the infill off and then with depth
+//! scales from deep to shallow; each set is scored against those tiles with the realism
+//! bar's own yardsticks (as the relief-hint calibration does, [`score`] and [`Trial::beats`]),
+//! and the best — possibly "off" — is written into the manifest. Run it last: the infill is
+//! the last step of each window.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::anyhow;
+use infiniterra_terrain::model::{load_model, ComputeBackend, DepressionInfill};
+
+use super::calibrate::{best, raster, score, spread, Trial};
+use super::data::read_split;
+use super::heldout::counterpart;
+use crate::eval::realism_bar;
+use crate::terrain::metrics::Raster;
+
+/// Depth scales tried after "off", metres, deepest first: from far deeper than any real
+/// closed basin at 1 km (they keep tens of metres) to a few metres, halving.
+pub const DEPTH_SCALES_M: [f64; 6] = [160.0, 80.0, 40.0, 20.0, 10.0, 5.0];
+
+/// "off" for `None`, the depth scale otherwise.
+fn label(depth: Option<f64>) -> String {
+    depth.map_or("off".into(), |c| format!("{c} m"))
+}
+
+/// Measures `<models>/<stage>.json` on `count` training tiles for each depth scale and writes
+/// the best as its `depression_infill` (or removes it when "off" is best).
+pub fn run(
+    models: &Path,
+    stage: &str,
+    data: &Path,
+    count: usize,
+    seed: u64,
+    backend: ComputeBackend,
+) -> anyhow::Result<()> {
+    let device = backend.device()?;
+    let mut model = load_model(models, stage, &device)?;
+    let path = models.join(format!("{stage}.json"));
+    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
+    if train.tiles.len() < 4 {
+        anyhow::bail!(
+            "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",
+            data.join(stage).display(),
+            train.tiles.len()
+        );
+    }
+    let count = count.clamp(2, train.tiles.len() / 2);
+    let metres = model.manifest.metres_per_pixel;
+    let tiles = spread(&train.tiles, count, 0.0);
+    let floor: Vec<Raster> = spread(&train.tiles, count, 0.5).into_iter().map(|t| raster(t, metres)).collect();
+    let reference: Vec<Raster> = tiles.iter().map(|t| raster(t, metres)).collect();
+    let seam_stride = model.manifest.window_stride();
+
+    let started = Instant::now();
+    // Trials carry the depth scale in `offset`; "off" is an infinite depth scale.
+    let mut tried: Vec<Trial> = Vec::new();
+    let mut short = 0;
+    for depth in std::iter::once(None).chain(DEPTH_SCALES_M.iter().map(|&c| Some(c))) {
+        model.manifest.depression_infill = depth.map(|c| DepressionInfill { depth_scale_m: c });
+        let generated: Vec<Raster> = tiles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                eprint!("\r  depth scale {}: tile {}/{}   ", label(depth), i + 1, tiles.len());
+                Raster::new(t.size, t.size, metres, counterpart(&model, &device, &t.h, t.size, seed + i as u64).0)
+            })
+            .collect();
+        let targets = realism_bar(&reference, &generated, &floor, seam_stride);
+        let trial = Trial {
+            offset: depth.unwrap_or(f64::INFINITY),
+            met: targets.iter().filter(|t| t.pass).count(),
+            score: score(&targets),
+        };
+        let fill = targets.iter().find(|t| t.key == "fill_volume_per_km2").map_or(f64::NAN, |t| t.value);
+        eprintln!(
+            "\rcalibrate {stage}: depth scale {} → score {:.3} ({}/{} met on {count} training tiles; fill {fill:.0} m³/km²; {:.0} s)",
+            label(depth),
+            trial.score,
+            trial.met,
+            targets.len(),
+            started.elapsed().as_secs_f64()
+        );
+        let before = best(&tried);
+        tried.push(trial);
+        // Shallower scales only flatten more: stop after two in a row that fall short.
+        short = if before.is_some_and(|b| !trial.beats(&b)) { short + 1 } else { 0 };
+        if short == 2 {
+            break;
+        }
+    }
+    let chosen = best(&tried).expect("depth scales were tried");
+    let depth = chosen.offset.is_finite().then_some(chosen.offset);
+    let summary: Vec<String> = tried
+        .iter()
+        .map(|t| format!("{}: {} met, {:.3}", label(t.offset.is_finite().then_some(t.offset)), t.met, t.score))
+        .collect();
+    println!(
+        "depression infill of {}: {} ({} lines met, score {:.3}; tried {})",
+        path.display(),
+        label(depth),
+        chosen.met,
+        chosen.score,
+        summary.join("; ")
+    );
+    crate::manifest_edit::edit_manifest(&path, |object| {
+        match depth {
+            Some(c) => {
+                object.insert("depression_infill".into(), serde_json::to_value(DepressionInfill { depth_scale_m: c })?)
+            }
+            None => object.remove("depression_infill"),
+        };
+        Ok(())
+    })
+}
