@@ -1,12 +1,13 @@
 //! Calibrating a stage's spectral equaliser on training tiles.
 //!
-//! The shipped model (its relief hint and response curve as they are, its old equaliser
-//! off) generates counterparts of real **training** tiles; the mean radial power spectra of
-//! the real and the generated tiles give, per wavelength, the amplitude gain √(real /
-//! generated) that [`SpectralEqualiser`] applies. A pass with the equaliser on measures what
-//! the kernel left and refines the gains; a last pass shows the result. Run it after the
-//! response curve: the curve sets how much relief each
-//! window gets, the equaliser only how it is shared out over wavelengths.
+//! The shipped model (its relief hint, response curve and depression infill as they are, its
+//! old equaliser off) generates counterparts of real **training** tiles; the mean radial
+//! power spectra of the real and the generated tiles give, per wavelength, the amplitude gain
+//! √(real / generated) that [`SpectralEqualiser`] applies. A pass with the equaliser on
+//! measures what the kernel left and refines the gains; a last pass shows the result. Run it
+//! after the response curve (the curve sets how much relief each window gets, the equaliser
+//! only how it is shared out over wavelengths), and again after `--calibrate-infill`: the
+//! infill follows the equaliser in each window, and what is measured is the final output.
 
 use std::path::Path;
 use std::time::Instant;
@@ -94,8 +95,6 @@ pub fn run(
     let mut model = load_model(models, stage, &device)?;
     let path = models.join(format!("{stage}.json"));
     model.manifest.spectral_equaliser = None;
-    // The infill comes after the equaliser in each window and is calibrated on its output.
-    model.manifest.depression_infill = None;
     let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
     let metres = model.manifest.metres_per_pixel;
