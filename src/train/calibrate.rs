@@ -91,6 +91,53 @@ pub(super) fn raster(tile: &EncodedTile, metres: f64) -> Raster {
     Raster::new(tile.size, tile.size, metres, tile.h.iter().map(|&v| signed_square(v)).collect())
 }
 
+/// What a bar-scored calibration generates and judges against: `count` training tiles spread
+/// over the split, and as many others (disjoint) for the real-vs-real floor.
+pub(super) struct BarSets<'a> {
+    /// The tiles whose counterparts are generated.
+    pub tiles: Vec<&'a EncodedTile>,
+    reference: Vec<Raster>,
+    floor: Vec<Raster>,
+    metres: f64,
+    seam_stride: usize,
+}
+
+impl<'a> BarSets<'a> {
+    /// The sets for `model` from `train` (read from `folder`, named in the error when it has
+    /// fewer than 4 tiles).
+    pub fn new(train: &'a TileSet, folder: &Path, count: usize, model: &LoadedModel) -> anyhow::Result<BarSets<'a>> {
+        if train.tiles.len() < 4 {
+            anyhow::bail!(
+                "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",
+                folder.display(),
+                train.tiles.len()
+            );
+        }
+        let count = count.clamp(2, train.tiles.len() / 2);
+        let metres = model.manifest.metres_per_pixel;
+        let tiles = spread(&train.tiles, count, 0.0);
+        let floor = spread(&train.tiles, count, 0.5).into_iter().map(|t| raster(t, metres)).collect();
+        let reference = tiles.iter().map(|t| raster(t, metres)).collect();
+        Ok(BarSets { tiles, reference, floor, metres, seam_stride: model.manifest.window_stride() })
+    }
+
+    /// `model`'s counterparts of the tiles (seeds `seed`, `seed + 1`, …) judged by the realism
+    /// bar; `progress(i)` is called before tile i.
+    pub fn judge(&self, model: &LoadedModel, device: &Device, seed: u64, progress: impl Fn(usize)) -> Vec<Target> {
+        let generated: Vec<Raster> = self
+            .tiles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                progress(i);
+                let h = counterpart(model, device, &t.h, t.size, seed + i as u64).0;
+                Raster::new(t.size, t.size, self.metres, h)
+            })
+            .collect();
+        realism_bar(&self.reference, &generated, &self.floor, self.seam_stride)
+    }
+}
+
 /// What both calibrations start from: the shipped model, its device, manifest path, relief
 /// hint, and the stage's training tiles (from `data`) encoded with its context.
 pub(super) struct Hinted {
@@ -147,19 +194,8 @@ pub fn run(
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
     let Hinted { mut model, device, path, train, .. } = load_hinted(models, stage, data, backend)?;
-    if train.tiles.len() < 4 {
-        anyhow::bail!(
-            "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",
-            data.join(stage).display(),
-            train.tiles.len()
-        );
-    }
-    let count = count.clamp(2, train.tiles.len() / 2);
-    let metres = model.manifest.metres_per_pixel;
-    let tiles = spread(&train.tiles, count, 0.0);
-    let floor: Vec<Raster> = spread(&train.tiles, count, 0.5).into_iter().map(|t| raster(t, metres)).collect();
-    let reference: Vec<Raster> = tiles.iter().map(|t| raster(t, metres)).collect();
-    let seam_stride = model.manifest.window_stride();
+    let sets = BarSets::new(&train, &data.join(stage), count, &model)?;
+    let count = sets.tiles.len();
 
     let started = Instant::now();
     let mut tried: Vec<Trial> = Vec::new();
@@ -167,14 +203,7 @@ pub fn run(
         if let Some(hint) = model.manifest.relief_hint.as_mut() {
             hint.offset = offset;
         }
-        let generated: Vec<Raster> = tiles
-            .iter()
-            .enumerate()
-            .map(|(i, t)| {
-                Raster::new(t.size, t.size, metres, counterpart(&model, &device, &t.h, t.size, seed + i as u64).0)
-            })
-            .collect();
-        let targets = realism_bar(&reference, &generated, &floor, seam_stride);
+        let targets = sets.judge(&model, &device, seed, |_| {});
         let s = score(&targets);
         let met = targets.iter().filter(|t| t.pass).count();
         let elapsed = started.elapsed().as_secs_f64();

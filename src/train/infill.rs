@@ -17,11 +17,8 @@ use std::time::Instant;
 use anyhow::anyhow;
 use infiniterra_terrain::model::{load_model, ComputeBackend, DepressionInfill};
 
-use super::calibrate::{best, raster, score, spread, Trial};
+use super::calibrate::{best, score, BarSets, Trial};
 use super::data::read_split;
-use super::heldout::counterpart;
-use crate::eval::realism_bar;
-use crate::terrain::metrics::Raster;
 
 /// Depth scales tried after "off", metres, deepest first, halving: from about the depth of
 /// real closed basins 30–60 km across at 1 km (60 m on held-out land, 16–32 km ones 40 m)
@@ -51,34 +48,16 @@ pub fn run(
     let mut model = load_model(models, stage, &device)?;
     let path = models.join(format!("{stage}.json"));
     let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
-    if train.tiles.len() < 4 {
-        anyhow::bail!(
-            "{}: {} training tiles; calibrating needs at least 4 (half to generate, half for the real-vs-real floor)",
-            data.join(stage).display(),
-            train.tiles.len()
-        );
-    }
-    let count = count.clamp(2, train.tiles.len() / 2);
-    let metres = model.manifest.metres_per_pixel;
-    let tiles = spread(&train.tiles, count, 0.0);
-    let floor: Vec<Raster> = spread(&train.tiles, count, 0.5).into_iter().map(|t| raster(t, metres)).collect();
-    let reference: Vec<Raster> = tiles.iter().map(|t| raster(t, metres)).collect();
-    let seam_stride = model.manifest.window_stride();
+    let sets = BarSets::new(&train, &data.join(stage), count, &model)?;
+    let count = sets.tiles.len();
 
     let started = Instant::now();
     // Trials carry the depth scale in `offset`; "off" is an infinite depth scale.
     let mut tried: Vec<Trial> = Vec::new();
     for depth in std::iter::once(None).chain(DEPTH_SCALES_M.iter().map(|&c| Some(c))) {
         model.manifest.depression_infill = depth.map(|c| DepressionInfill { depth_scale_m: c });
-        let generated: Vec<Raster> = tiles
-            .iter()
-            .enumerate()
-            .map(|(i, t)| {
-                eprint!("\r  depth scale {}: tile {}/{}   ", label(depth), i + 1, tiles.len());
-                Raster::new(t.size, t.size, metres, counterpart(&model, &device, &t.h, t.size, seed + i as u64).0)
-            })
-            .collect();
-        let mut targets = realism_bar(&reference, &generated, &floor, seam_stride);
+        let mut targets = sets
+            .judge(&model, &device, seed, |i| eprint!("\r  depth scale {}: tile {}/{count}   ", label(depth), i + 1));
         targets.retain(|t| t.key != SPECTRAL_LINE);
         let trial = Trial {
             offset: depth.unwrap_or(f64::INFINITY),
