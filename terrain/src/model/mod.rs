@@ -16,6 +16,7 @@ pub mod equaliser;
 pub mod hint;
 pub mod infill;
 mod layers;
+pub mod projection;
 mod rng;
 mod sampler;
 pub mod stage;
@@ -36,6 +37,7 @@ pub use equaliser::SpectralEqualiser;
 pub use hint::{HintCheck, ReliefHint};
 pub use infill::DepressionInfill;
 pub use layers::{force_normalize, mp_cat, mp_silu, mp_sum, normalize_rows, pixel_norm, MpConv, MpLinear};
+pub use projection::ContextProjection;
 pub use rng::HostRng;
 pub use sampler::{Guide, Sampler, SamplerKind};
 pub use store::{

@@ -16,6 +16,7 @@ use burn::tensor::{Device, Tensor, TensorData};
 
 use super::equaliser::EqualiserKernel;
 use super::infill::DepressionInfill;
+use super::projection::ContextProjection;
 use super::store::{LoadedModel, Normalisation};
 use super::{Guidance, Guide, ReliefHint, Sampler, UNet};
 use crate::encoding::{blur, signed_sqrt, signed_square, ContextSpec};
@@ -48,6 +49,7 @@ pub struct LearnedStage {
     norm: Normalisation,
     hint: Option<ReliefHint>,
     equaliser: Option<EqualiserKernel>,
+    projection: Option<ContextProjection>,
     infill: Option<DepressionInfill>,
     spec: ContextSpec,
     coarse: Arc<dyn Source>,
@@ -70,6 +72,7 @@ impl LearnedStage {
             norm: model.manifest.normalisation.clone(),
             hint: model.manifest.relief_hint.clone(),
             equaliser: model.manifest.spectral_equaliser.as_ref().map(EqualiserKernel::new),
+            projection: model.manifest.context_projection.clone(),
             infill: model.manifest.depression_infill.clone(),
             spec: model.manifest.context,
             guide: model.guide.zip(model.manifest.guidance.clone()),
@@ -87,13 +90,24 @@ impl LearnedStage {
     /// signed-sqrt low band the output is added to. Built exactly like training's low band:
     /// the coarse grid (box means) in signed sqrt, blurred if the stage's context is,
     /// bilinearly upsampled — the blur reads `BLUR_RADIUS` extra cells on each side, so
-    /// neighbouring windows agree.
-    pub(crate) fn context(&self, rect: Rect) -> (Vec<f32>, Vec<f32>) {
+    /// neighbouring windows agree. Third, the window's own context cells in signed sqrt
+    /// (unblurred, row-major): what its output's cell means should equal.
+    pub(crate) fn context(&self, rect: Rect) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
         let f = self.spec.factor as i64;
         let src = upsample::source_rect(&rect, f);
         let r = self.spec.margin() as i64;
         let padded = Rect::new(src.y0 - r, src.x0 - r, src.h + 2 * r, src.w + 2 * r);
         let h: Vec<f32> = self.coarse.query(padded).data.iter().map(|&e| signed_sqrt(e)).collect();
+        let cells = {
+            let (oy, ox) = (rect.y0.div_euclid(f) - padded.y0, rect.x0.div_euclid(f) - padded.x0);
+            let n = rect.w / f;
+            (0..rect.h / f)
+                .flat_map(|y| {
+                    let row = ((oy + y) * padded.w + ox) as usize;
+                    h[row..row + n as usize].iter().copied()
+                })
+                .collect()
+        };
         let blurred = if self.spec.blur { blur(&h, padded.h as usize, padded.w as usize) } else { h };
         let inner = (0..src.h)
             .flat_map(|y| {
@@ -103,7 +117,7 @@ impl LearnedStage {
             .collect();
         let low = upsample::bilinear(&Tile::from_data(1, src, inner), f, rect).data;
         let cond = low.iter().map(|&v| (v - self.norm.cond_mean) / self.norm.cond_scale).collect();
-        (cond, low)
+        (cond, low, cells)
     }
 
     /// The conditioning vectors of windows whose low bands are `lows`, row-major
@@ -151,10 +165,12 @@ impl WindowFn for LearnedStage {
         let rects: Vec<Rect> = windows.iter().map(|&w| layout.rect(w)).collect();
         let mut cond = Vec::with_capacity(b * n);
         let mut lows = Vec::with_capacity(b);
+        let mut cells = Vec::with_capacity(b);
         for &r in &rects {
-            let (c, low) = self.context(r);
+            let (c, low, cell) = self.context(r);
             cond.extend_from_slice(&c);
             lows.push(low);
+            cells.push(cell);
         }
         let noises: Vec<Tensor<4>> = (0..self.sampler.noises_needed())
             .map(|step| {
@@ -179,11 +195,16 @@ impl WindowFn for LearnedStage {
         rects
             .iter()
             .zip(lows)
+            .zip(cells)
             .enumerate()
-            .map(|(i, (&r, low))| {
+            .map(|(i, ((&r, low), cell))| {
                 let residual = &values[i * n..(i + 1) * n];
-                let metres: Vec<f32> =
-                    low.iter().zip(residual).map(|(&l, &x)| signed_square(l + x * self.norm.target_scale)).collect();
+                let h: Vec<f32> = low.iter().zip(residual).map(|(&l, &x)| l + x * self.norm.target_scale).collect();
+                let h = match &self.projection {
+                    Some(p) => p.apply(&h, side, self.spec.factor, &cell),
+                    None => h,
+                };
+                let metres: Vec<f32> = h.into_iter().map(signed_square).collect();
                 let metres = match &self.equaliser {
                     Some(kernel) => kernel.apply(&metres, side),
                     None => metres,

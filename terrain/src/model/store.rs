@@ -18,6 +18,7 @@ use sha2::{Digest, Sha256};
 use super::equaliser::SpectralEqualiser;
 use super::hint::ReliefHint;
 use super::infill::DepressionInfill;
+use super::projection::ContextProjection;
 use super::sampler::Sampler;
 use super::unet::{UNet, UNetConfig};
 use crate::encoding::ContextSpec;
@@ -141,6 +142,10 @@ pub struct ModelManifest {
     /// output as the network draws it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spectral_equaliser: Option<SpectralEqualiser>,
+    /// Back-projection of each window's output onto its context cells, before the equaliser
+    /// (none: cell means as the network draws them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub context_projection: Option<ContextProjection>,
     /// Sediment infill of closed basins in each window's output, after the equaliser (none:
     /// basins as the network draws them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -194,6 +199,7 @@ impl ModelManifest {
             normalisation: Normalisation::default(),
             relief_hint: None,
             spectral_equaliser: None,
+            context_projection: None,
             depression_infill: None,
             sampler,
             guidance: None,
@@ -363,6 +369,17 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
     }
     if let Some(infill) = &manifest.depression_infill {
         infill.validate().map_err(manifest_corrupt)?;
+    }
+    if let Some(projection) = &manifest.context_projection {
+        projection.validate(manifest.context.blur).map_err(manifest_corrupt)?;
+        // A window's cells are whole context cells only when every window starts on one.
+        if manifest.window_stride() % manifest.context.factor != 0 {
+            return Err(manifest_corrupt(format!(
+                "context_projection needs windows on context cells: stride {} is not a multiple of context.factor = {}",
+                manifest.window_stride(),
+                manifest.context.factor
+            )));
+        }
     }
     if !(manifest.metres_per_pixel.is_finite() && manifest.metres_per_pixel > 0.0) {
         return Err(manifest_corrupt(format!("metres_per_pixel = {} (must be positive)", manifest.metres_per_pixel)));

@@ -422,7 +422,7 @@ fn a_window_s_context_is_the_low_band_training_computes() {
         (0..n as i64).flat_map(|y| (0..n as i64).map(move |x| signed_sqrt(fine_metres(t0.0 + y, t0.1 + x)))).collect();
     let low = upsample_low(&lowpass(&h, n, n), n, n);
     let window = Rect::new(t0.0 + 64, t0.1 + 48, 32, 32);
-    let (_, got) = stage.context(window);
+    let (_, got, _) = stage.context(window);
     let mut worst = 0.0f32;
     for y in 0..32 {
         for x in 0..32 {
@@ -681,5 +681,72 @@ fn the_depression_infill_follows_the_equaliser_in_each_window_and_is_checked_on_
     save_model(&dir, &net, manifest, Precision::F32).expect("save");
     let msg = load_model(&dir, "test", &device()).expect_err("negative depth scale").to_string();
     assert!(msg.contains("test.json") && msg.contains("depression_infill.depth_scale_m"), "{msg}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The tiny core on an unblurred 8× context (the shipped core's), with a context projection
+/// or without.
+fn tiny_core_projected(batch: usize, projection: Option<ContextProjection>) -> LearnedStage {
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    manifest.context = crate::encoding::ContextSpec { factor: 8, blur: false };
+    manifest.normalisation =
+        Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
+    manifest.context_projection = projection;
+    LearnedStage::new(LoadedModel { net, manifest, guide: None }, device(), Arc::new(Hills), 42, batch)
+}
+
+#[test]
+fn the_context_projection_makes_each_window_average_to_its_context_and_is_checked_on_load() {
+    use super::projection::block_means;
+    use crate::encoding::signed_sqrt;
+    let projection = ContextProjection { iterations: 6 };
+    let windows = [WindowIndex { iy: -1, ix: 2 }, WindowIndex { iy: 0, ix: 0 }, WindowIndex { iy: 1, ix: -1 }];
+    let plain = tiny_core_projected(3, None);
+    let projected = tiny_core_projected(3, Some(projection.clone()));
+    let (before, after) = (plain.eval(&windows), projected.eval(&windows));
+    // Cell means of the output (signed sqrt, as training's context is made) against the
+    // window's context cells.
+    let miss = |t: &Tile| {
+        let h: Vec<f32> = t.data.iter().map(|&m| signed_sqrt(m)).collect();
+        let cells = plain.context(t.rect).2;
+        block_means(&h, 32, 8).iter().zip(&cells).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max)
+    };
+    for (b, a) in before.iter().zip(&after) {
+        assert_eq!(a.rect, b.rect);
+        let (was, is) = (miss(b), miss(a));
+        assert!(
+            was > 0.5,
+            "window {:?}: the network already matched its context ({was}): the test shows nothing",
+            a.rect
+        );
+        assert!(is < 0.02 * was, "window {:?}: cell means miss the context by {is} (network alone: {was})", a.rect);
+    }
+    // Through the engine it stays a pure function of the region.
+    let region = Rect::new(-40, 25, 48, 40);
+    let whole = Windowed::new(
+        &Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 }),
+        tiny_core_projected(4, Some(projection.clone())),
+    )
+    .query(region);
+    let part = Windowed::new(
+        &Engine::new(EngineConfig { cache_bytes: 1 << 20, threads: 1 }),
+        tiny_core_projected(3, Some(projection.clone())),
+    )
+    .query(Rect::new(-20, 40, 16, 16));
+    assert_eq!(whole.crop(part.rect), part);
+
+    // On a blurred context (whose cells are not what the output averages to) it is refused on
+    // load, naming the file and the entry.
+    let dir = tempdir("projection");
+    let net = perturbed_tiny(11);
+    let mut manifest = manifest_for(&net);
+    manifest.window = 32;
+    manifest.context = crate::encoding::ContextSpec { factor: 8, blur: true };
+    manifest.context_projection = Some(projection);
+    save_model(&dir, &net, manifest, Precision::F32).expect("save");
+    let msg = load_model(&dir, "test", &device()).expect_err("blurred context").to_string();
+    assert!(msg.contains("test.json") && msg.contains("context_projection"), "{msg}");
     let _ = std::fs::remove_dir_all(&dir);
 }
