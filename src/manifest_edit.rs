@@ -22,3 +22,25 @@ pub fn edit_manifest(
         .and_then(|()| std::fs::rename(&tmp, path))
         .with_context(|| format!("writing {}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_left_alone_keep_their_floats_to_the_last_digit() {
+        // Gains a calibration once wrote; serde_json's default float parser reads some of them
+        // one unit in the last place off, so a rewrite changed numbers nobody edited.
+        let text = "{\n  \"gains\": [\n    0.9880082275194835,\n    0.9665533279319569,\n    1.1697618301393617\n  ],\n  \"n\": 1\n}\n";
+        let path = std::env::temp_dir().join(format!("infiniterra-manifest-edit-{}.json", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        edit_manifest(&path, |object| {
+            object.insert("n".into(), 2.into());
+            Ok(())
+        })
+        .unwrap();
+        let after = std::fs::read_to_string(&path).unwrap();
+        let _ = std::fs::remove_file(&path);
+        assert_eq!(after, text.replace("\"n\": 1", "\"n\": 2"));
+    }
+}

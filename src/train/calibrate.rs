@@ -153,8 +153,9 @@ pub(super) struct Hinted {
 pub(super) fn load_hinted(models: &Path, stage: &str, data: &Path, backend: ComputeBackend) -> anyhow::Result<Hinted> {
     let device = backend.device()?;
     let mut model = load_model(models, stage, &device)?;
-    // Both calibrations measure the network's own answer: the equaliser and the infill are
-    // calibrated on it afterwards.
+    // Both calibrations measure the network's own answer: the steps after it in each window
+    // (context projection, equaliser, infill) are calibrated on it afterwards.
+    model.manifest.context_projection = None;
     model.manifest.spectral_equaliser = None;
     model.manifest.depression_infill = None;
     let path = models.join(format!("{stage}.json"));
