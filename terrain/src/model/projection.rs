@@ -17,6 +17,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::encoding::box_downsample;
 use crate::tile::{Rect, Tile};
 use crate::upsample;
 
@@ -58,7 +59,7 @@ impl ContextProjection {
         let source = upsample::source_rect(&fine, factor as i64);
         let mut out = values.to_vec();
         for _ in 0..self.iterations {
-            let means = block_means(&out, side, factor);
+            let means = box_downsample(&out, side, side, factor);
             // The difference on the window's cells, extended flat beyond them: outside the
             // window there is no output to compare with, and the flat extension keeps the
             // correction from tilting at the edges.
@@ -76,18 +77,6 @@ impl ContextProjection {
         }
         out
     }
-}
-
-/// Means of the `factor`×`factor` blocks of a `side`×`side` field, row-major.
-pub fn block_means(values: &[f32], side: usize, factor: usize) -> Vec<f32> {
-    let n = side / factor;
-    let mut sums = vec![0.0f64; n * n];
-    for (i, &v) in values.iter().enumerate() {
-        let (y, x) = (i / side, i % side);
-        sums[(y / factor) * n + x / factor] += f64::from(v);
-    }
-    let area = (factor * factor) as f64;
-    sums.iter().map(|s| (s / area) as f32).collect()
 }
 
 #[cfg(test)]
@@ -108,9 +97,9 @@ mod tests {
     fn the_cell_means_converge_to_the_context_and_the_fine_relief_stays() {
         let (side, factor) = (64, 8);
         let values = field(side, 1);
-        let cells: Vec<f32> = block_means(&field(side, 5), side, factor);
+        let cells: Vec<f32> = box_downsample(&field(side, 5), side, side, factor);
         let worst = |v: &[f32]| -> f32 {
-            block_means(v, side, factor).iter().zip(&cells).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max)
+            box_downsample(v, side, side, factor).iter().zip(&cells).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max)
         };
         let before = worst(&values);
         let mut last = before;
@@ -140,7 +129,7 @@ mod tests {
     fn a_window_true_to_its_context_is_left_alone() {
         let (side, factor) = (32, 8);
         let values = field(side, 3);
-        let cells = block_means(&values, side, factor);
+        let cells = box_downsample(&values, side, side, factor);
         let out = ContextProjection { iterations: 4 }.apply(&values, side, factor, &cells);
         let worst = out.iter().zip(&values).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
         assert!(worst < 1e-4, "moved by {worst}");

@@ -699,7 +699,7 @@ fn tiny_core_projected(batch: usize, projection: Option<ContextProjection>) -> L
 
 #[test]
 fn the_context_projection_makes_each_window_average_to_its_context_and_is_checked_on_load() {
-    use super::projection::block_means;
+    use crate::encoding::box_downsample;
     use crate::encoding::signed_sqrt;
     let projection = ContextProjection { iterations: 6 };
     let windows = [WindowIndex { iy: -1, ix: 2 }, WindowIndex { iy: 0, ix: 0 }, WindowIndex { iy: 1, ix: -1 }];
@@ -711,7 +711,7 @@ fn the_context_projection_makes_each_window_average_to_its_context_and_is_checke
     let miss = |t: &Tile| {
         let h: Vec<f32> = t.data.iter().map(|&m| signed_sqrt(m)).collect();
         let cells = plain.context(t.rect).2;
-        block_means(&h, 32, 8).iter().zip(&cells).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max)
+        box_downsample(&h, 32, 32, 8).iter().zip(&cells).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max)
     };
     for (b, a) in before.iter().zip(&after) {
         assert_eq!(a.rect, b.rect);
