@@ -11,15 +11,35 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Number of context features (a constant included).
-pub const FEATURES: usize = 4;
-/// Names of the features, in coefficient order, for the manifest and logs.
-pub const FEATURE_NAMES: [&str; FEATURES] = ["1", "mean_low", "ln_std_low", "ln_mean_gradient_low"];
+/// Every context statistic this build can compute, in the order [`features`] returns them. A
+/// manifest's hint names the ones it was fitted on, so a hint fitted on fewer (an older fit)
+/// keeps working.
+pub const KNOWN_FEATURES: [&str; 8] = [
+    "1",
+    "mean_low",
+    "ln_std_low",
+    "ln_mean_gradient_low",
+    "ln_mean_laplacian_blocks",
+    "ln_max_abs_blocks",
+    "land_fraction_blocks",
+    "ln_median_gradient_blocks",
+];
+/// Number of features a new fit uses (a constant included).
+pub const FEATURES: usize = KNOWN_FEATURES.len();
+/// Names of the features a new fit uses, in coefficient order, for the manifest and logs: all
+/// of them. The first four alone explain 86–88 % of the variance of the core's `relief_z`
+/// (training / held-out windows); with the block statistics 90–92 %, the rms error falling
+/// from 0.35 to 0.28 z on held-out land (measured in Python on 4,000 crops each).
+pub const FEATURE_NAMES: [&str; FEATURES] = KNOWN_FEATURES;
+/// Side of the blocks the `*_blocks` statistics average the low band over, pixels: the core's
+/// context cell, so the statistics see the 8 km grid the pipeline conditions on (for other
+/// stages simply a coarser view of their low band).
+pub const BLOCK: usize = 8;
 
 /// A linear predictor of the relief entry of the conditioning vector.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReliefHint {
-    /// What each coefficient multiplies ([`FEATURE_NAMES`]).
+    /// What each coefficient multiplies (names from [`KNOWN_FEATURES`]).
     pub features: Vec<String>,
     /// One coefficient per feature.
     pub coefficients: Vec<f64>,
@@ -53,7 +73,9 @@ pub struct HintCheck {
 }
 
 /// The context statistics of one square window of side `side`: its low band in signed-sqrt
-/// units (√m), as the model's conditioning channel holds it before normalisation.
+/// units (√m), as the model's conditioning channel holds it before normalisation. All of
+/// [`KNOWN_FEATURES`], in that order. The block statistics read the means of [`BLOCK`]-sided
+/// blocks (0 where the window holds fewer than 3×3 of them).
 pub fn features(low: &[f32], side: usize) -> [f64; FEATURES] {
     assert_eq!(low.len(), side * side);
     let n = low.len() as f64;
@@ -67,32 +89,95 @@ pub fn features(low: &[f32], side: usize) -> [f64; FEATURES] {
         }
     }
     let gradient = gradient / ((side - 1) * (side - 1)) as f64;
-    [1.0, mean / 100.0, (var.sqrt() + 1e-2).ln(), (gradient + 1e-3).ln()]
+    let [laplacian, max_abs, land, median_gradient] = block_statistics(low, side);
+    [1.0, mean / 100.0, (var.sqrt() + 1e-2).ln(), (gradient + 1e-3).ln(), laplacian, max_abs, land, median_gradient]
+}
+
+/// Statistics of the [`BLOCK`]-sided block means `c` (k×k) of a window's low band: ln of the
+/// mean |discrete Laplacian| over interior blocks, ln(max |c| + 1), the fraction of blocks
+/// above sea level, and ln of the median gradient magnitude (central differences, one-sided
+/// at the edges). Where relief changes within a window (a range rising from a plain) the
+/// first and last see it; the window's standard deviation and mean gradient do not.
+fn block_statistics(low: &[f32], side: usize) -> [f64; 4] {
+    let k = side / BLOCK;
+    if k < 3 {
+        return [0.0; 4];
+    }
+    let mut c = vec![0.0f64; k * k];
+    for y in 0..k * BLOCK {
+        for x in 0..k * BLOCK {
+            c[(y / BLOCK) * k + x / BLOCK] += low[y * side + x] as f64;
+        }
+    }
+    let area = (BLOCK * BLOCK) as f64;
+    c.iter_mut().for_each(|v| *v /= area);
+    let at = |y: usize, x: usize| c[y * k + x];
+    let mut laplacian = 0.0;
+    for y in 1..k - 1 {
+        for x in 1..k - 1 {
+            laplacian += (4.0 * at(y, x) - at(y - 1, x) - at(y + 1, x) - at(y, x - 1) - at(y, x + 1)).abs();
+        }
+    }
+    let laplacian = laplacian / ((k - 2) * (k - 2)) as f64;
+    let max_abs = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let land = c.iter().filter(|&&v| v > 0.0).count() as f64 / (k * k) as f64;
+    // Central differences inside, one-sided at the edges (numpy's `gradient`).
+    let derivative = |i: usize, get: &dyn Fn(usize) -> f64| match i {
+        0 => get(1) - get(0),
+        i if i == k - 1 => get(k - 1) - get(k - 2),
+        i => (get(i + 1) - get(i - 1)) / 2.0,
+    };
+    let mut magnitudes: Vec<f64> = (0..k * k)
+        .map(|i| {
+            let (y, x) = (i / k, i % k);
+            let dy = derivative(y, &|j| at(j, x));
+            let dx = derivative(x, &|j| at(y, j));
+            dy.hypot(dx)
+        })
+        .collect();
+    magnitudes.sort_by(f64::total_cmp);
+    let m = magnitudes.len();
+    let median = if m % 2 == 1 { magnitudes[m / 2] } else { (magnitudes[m / 2 - 1] + magnitudes[m / 2]) / 2.0 };
+    [(laplacian + 1e-3).ln(), (max_abs + 1.0).ln(), land, (median + 1e-3).ln()]
+}
+
+/// Index into [`KNOWN_FEATURES`] of each named feature; `None` for a name this build does not know.
+fn feature_indices(names: &[String]) -> Option<Vec<usize>> {
+    names.iter().map(|name| KNOWN_FEATURES.iter().position(|k| k == name)).collect()
 }
 
 impl ReliefHint {
-    /// Least-squares fit of `targets` on the feature rows `x`. `None` when the system is
-    /// singular (too few or degenerate samples).
+    /// Least-squares fit of `targets` on the feature rows `x` (all of [`FEATURE_NAMES`]).
+    /// Features that do not vary over the samples (every block above sea level, say) are left
+    /// out of the fit and of the hint, so they cannot make the system singular. `None` when
+    /// nothing but the constant varies, or the rest is degenerate (collinear).
     pub fn fit(x: &[[f64; FEATURES]], targets: &[f64]) -> Option<ReliefHint> {
         assert_eq!(x.len(), targets.len());
+        let first = x.first()?;
+        let used: Vec<usize> =
+            (0..FEATURES).filter(|&i| i == 0 || x.iter().any(|row| (row[i] - first[i]).abs() > 1e-12)).collect();
+        if used.len() < 2 {
+            return None;
+        }
         // Normal equations XᵀX·c = Xᵀy, solved by Gaussian elimination with partial pivoting
-        // (4×4: no library needed).
-        let mut a = [[0.0f64; FEATURES + 1]; FEATURES];
+        // (at most 8×8: no library needed).
+        let m = used.len();
+        let mut a = vec![vec![0.0f64; m + 1]; m];
         for (row, &t) in x.iter().zip(targets) {
-            for i in 0..FEATURES {
-                for j in 0..FEATURES {
-                    a[i][j] += row[i] * row[j];
+            for (i, &fi) in used.iter().enumerate() {
+                for (j, &fj) in used.iter().enumerate() {
+                    a[i][j] += row[fi] * row[fj];
                 }
-                a[i][FEATURES] += row[i] * t;
+                a[i][m] += row[fi] * t;
             }
         }
-        for col in 0..FEATURES {
-            let pivot = (col..FEATURES).max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs()))?;
+        for col in 0..m {
+            let pivot = (col..m).max_by(|&p, &q| a[p][col].abs().total_cmp(&a[q][col].abs()))?;
             if a[pivot][col].abs() < 1e-9 {
                 return None;
             }
             a.swap(col, pivot);
-            let pivot_row = a[col];
+            let pivot_row = a[col].clone();
             for (r, row) in a.iter_mut().enumerate() {
                 if r != col {
                     let f = row[col] / pivot_row[col];
@@ -102,9 +187,12 @@ impl ReliefHint {
                 }
             }
         }
-        let coefficients: Vec<f64> = (0..FEATURES).map(|i| a[i][FEATURES] / a[i][i]).collect();
+        let coefficients: Vec<f64> = (0..m).map(|i| a[i][m] / a[i][i]).collect();
+        if coefficients.iter().any(|c| !c.is_finite()) {
+            return None;
+        }
         let mut hint = ReliefHint {
-            features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
+            features: used.iter().map(|&i| FEATURE_NAMES[i].to_string()).collect(),
             coefficients,
             r2: 0.0,
             offset: 0.0,
@@ -122,11 +210,7 @@ impl ReliefHint {
         let n = targets.len().max(1) as f64;
         let mean = targets.iter().sum::<f64>() / n;
         let total: f64 = targets.iter().map(|t| (t - mean).powi(2)).sum();
-        let errors: Vec<f64> = x
-            .iter()
-            .zip(targets)
-            .map(|(row, t)| t - row.iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>())
-            .collect();
+        let errors: Vec<f64> = x.iter().zip(targets).map(|(row, t)| t - self.combine(row)).collect();
         let residual: f64 = errors.iter().map(|e| e * e).sum();
         HintCheck {
             r2: if total > 0.0 { 1.0 - residual / total } else { 0.0 },
@@ -138,7 +222,13 @@ impl ReliefHint {
     /// The fit's estimate of the true `relief_z` of a window whose low band is `low` (side
     /// `side`): what the window should look like, before any correction for the network.
     pub fn expected(&self, low: &[f32], side: usize) -> f64 {
-        features(low, side).iter().zip(&self.coefficients).map(|(f, c)| f * c).sum::<f64>()
+        self.combine(&features(low, side))
+    }
+
+    /// The linear combination of this hint's features out of a row of all of them.
+    fn combine(&self, all: &[f64; FEATURES]) -> f64 {
+        let indices = feature_indices(&self.features).expect("validated: every feature is known");
+        indices.iter().zip(&self.coefficients).map(|(&i, c)| all[i] * c).sum::<f64>()
     }
 
     /// What the network is asked for in a window whose low band is `low` (side `side`): the
@@ -163,11 +253,17 @@ impl ReliefHint {
 
     /// Checks the manifest entry has the shape this code computes.
     pub fn validate(&self) -> Result<(), String> {
-        if self.features != FEATURE_NAMES {
-            return Err(format!("relief_hint.features = {:?}, this build computes {:?}", self.features, FEATURE_NAMES));
+        if feature_indices(&self.features).is_none() || self.features.is_empty() {
+            return Err(format!(
+                "relief_hint.features = {:?}: each must be one this build computes, {:?}",
+                self.features, KNOWN_FEATURES
+            ));
         }
-        if self.coefficients.len() != FEATURES || self.coefficients.iter().any(|c| !c.is_finite()) {
-            return Err(format!("relief_hint.coefficients must be {FEATURES} finite numbers"));
+        if self.coefficients.len() != self.features.len() || self.coefficients.iter().any(|c| !c.is_finite()) {
+            return Err(format!(
+                "relief_hint.coefficients must be {} finite numbers, one per feature",
+                self.features.len()
+            ));
         }
         if !self.offset.is_finite() {
             return Err(format!("relief_hint.offset = {} is not a finite number", self.offset));
@@ -246,7 +342,49 @@ mod tests {
         let flat = vec![3.0f32; 64];
         let x = vec![features(&flat, 8); 10];
         assert_eq!(ReliefHint::fit(&x, &[1.0; 10]), None);
-        let bad = ReliefHint { features: vec!["1".into()], coefficients: vec![0.0], ..Default::default() };
-        assert!(bad.validate().unwrap_err().contains("relief_hint.features"));
+        let bad = ReliefHint {
+            features: vec!["1".into(), "ln_roughness_of_something_else".into()],
+            coefficients: vec![0.0; 2],
+            ..Default::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("ln_roughness_of_something_else"));
+        let short =
+            ReliefHint { features: vec!["1".into(), "mean_low".into()], coefficients: vec![0.0], ..Default::default() };
+        assert!(short.validate().unwrap_err().contains("relief_hint.coefficients"));
+    }
+
+    /// A manifest fitted on the first four features (before the block statistics) still
+    /// predicts exactly what it predicted: the same linear combination of the same values.
+    #[test]
+    fn a_hint_fitted_on_fewer_features_keeps_its_meaning() {
+        let side = 64;
+        let low: Vec<f32> =
+            (0..side * side).map(|i| 20.0 + ((i % side) as f32 * 0.2).sin() * (i / side) as f32 * 0.3).collect();
+        let all = features(&low, side);
+        let old = ReliefHint {
+            features: KNOWN_FEATURES[..4].iter().map(|s| s.to_string()).collect(),
+            coefficients: vec![3.0, -0.19, -0.62, 1.47],
+            ..Default::default()
+        };
+        old.validate().expect("a four-feature hint is valid");
+        let want = 3.0 - 0.19 * all[1] - 0.62 * all[2] + 1.47 * all[3];
+        assert!((old.expected(&low, side) - want).abs() < 1e-12);
+    }
+
+    /// The block statistics: a window that is a plain on one side and a range on the other has
+    /// a larger median gradient and Laplacian than a uniform slope with the same spread, and
+    /// the land fraction counts blocks above sea level.
+    #[test]
+    fn block_statistics_see_where_relief_changes() {
+        let side = 64;
+        let ramp: Vec<f32> = (0..side * side).map(|i| (i % side) as f32 - 32.0).collect();
+        let step: Vec<f32> = (0..side * side)
+            .map(|i| if (i % side) < 40 { -10.0 } else { 20.0 + 3.0 * ((i % side) as f32 - 40.0) })
+            .collect();
+        let (r, s) = (features(&ramp, side), features(&step, side));
+        assert!((r[6] - 0.5).abs() < 1e-12, "half the ramp's blocks lie above sea level: {}", r[6]);
+        assert!(s[4] > r[4] + 1.0, "a kink has curvature, a ramp none: {} vs {}", s[4], r[4]);
+        assert!(s[5] > r[5], "max |block|: {} vs {}", s[5], r[5]);
+        assert_eq!(features(&ramp[..16 * 16], 16)[4..], [0.0; 4], "fewer than 3×3 blocks: no block statistics");
     }
 }

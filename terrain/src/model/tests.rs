@@ -448,7 +448,7 @@ fn the_relief_hint_steers_each_window_from_its_own_context() {
         Normalisation { target_scale: 4.0, cond_mean: 10.0, cond_scale: 20.0, relief_mean: 0.0, relief_std: 1.0 };
     manifest.relief_hint = Some(ReliefHint {
         features: FEATURE_NAMES.iter().map(|s| s.to_string()).collect(),
-        coefficients: vec![0.5, 0.1, 0.8, 0.3],
+        coefficients: vec![0.5, 0.1, 0.8, 0.3, 0.2, -0.1, 0.3, 0.4],
         r2: 0.9,
         offset: 0.2,
         response: Vec::new(),
