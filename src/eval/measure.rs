@@ -2,8 +2,8 @@
 //! subsample of) every pixel's value, spectra are averaged, counts and sums are added.
 
 use crate::terrain::metrics::{
-    depressions, fit_beta, radial_power_spectrum, relative_elevation, seam_ratio, slope_degrees, Depressions, Raster,
-    SeamLines, SeamStats, Spectrum, RELIEF_RADIUS,
+    beta_sampling_sd, depressions, fit_beta, radial_power_spectrum, relative_elevation, seam_ratio, slope_degrees,
+    Depressions, Raster, SeamLines, SeamStats, Spectrum, RELIEF_RADIUS,
 };
 
 /// Most values kept per distribution: W1 sorts them, and 2·10⁶ already pins every quantile
@@ -31,6 +31,8 @@ pub struct SetMetrics {
     pub spectrum: Option<Spectrum>,
     /// Fitted spectral slope of the mean spectrum.
     pub beta: f64,
+    /// Standard error of `beta` from the choice of tiles (bootstrap over the tiles).
+    pub beta_sd: f64,
     /// Pooled depression statistics.
     pub depressions: Depressions,
     /// Pooled seam sums.
@@ -83,6 +85,7 @@ pub fn measure(tiles: &[Raster], lines: SeamLines, progress: &mut dyn FnMut(u64,
     let modal = spectra.iter().map(|s| s.power.len()).max().unwrap_or(0);
     let same: Vec<Spectrum> = spectra.into_iter().filter(|s| s.power.len() == modal && modal > 0).collect();
     let spectrum = Spectrum::mean(&same);
+    let beta_sd = beta_sampling_sd(&same);
     SetMetrics {
         tiles: tiles.len(),
         land_fraction: land as f64 / pixels.max(1) as f64,
@@ -90,6 +93,7 @@ pub fn measure(tiles: &[Raster], lines: SeamLines, progress: &mut dyn FnMut(u64,
         slopes: slopes.kept,
         relief: relief.kept,
         beta: spectrum.as_ref().map_or(f64::NAN, fit_beta),
+        beta_sd,
         spectrum,
         depressions: drainage,
         seams,

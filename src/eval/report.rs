@@ -155,6 +155,7 @@ impl Report {
                 distance(&|m| cell(chi2_distance(&histogram(&m.relief, &relief_edges), &relief_ref), 3)),
             ),
             ("spectral slope β (power ∝ k^β)".into(), value(&|m| cell(m.beta, 2))),
+            ("β standard error (bootstrap over tiles)".into(), value(&|m| cell(m.beta_sd, 3))),
             ("|Δβ| to reference".into(), distance(&|m| cell((m.beta - reference.beta).abs(), 2))),
             ("depressions ≥ 1 m per 1000 km²".into(), value(&|m| cell(m.depressions.per_1000_km2(), 2))),
             ("fill volume per area (m³/km²)".into(), value(&|m| cell(m.depressions.volume_per_km2(), 0))),

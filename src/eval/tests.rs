@@ -128,6 +128,7 @@ fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
         "slope χ²",
         "rel. elevation W1",
         "spectral slope β",
+        "β standard error",
         "|Δβ|",
         "depressions",
         "fill volume",
@@ -145,6 +146,8 @@ fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
     assert_eq!(calls, 4 + 4 + 2 + 3, "progress once per tile");
     let beta: f64 = report.get("spectral slope", 2).unwrap().parse().unwrap();
     assert!((-3.6..=-2.4).contains(&beta), "fBm baseline β = {beta}");
+    let sd: f64 = report.get("β standard error", 0).unwrap().parse().unwrap();
+    assert!(sd > 0.0 && sd < 0.5, "four different tiles: a finite, non-zero standard error, got {sd}");
     let seam: f64 = report.get("seam ratio", 1).unwrap().parse().unwrap();
     assert!((0.8..1.25).contains(&seam), "seamless noise has seam ratio ≈ 1, got {seam}");
     let img = image::open(&out).unwrap();

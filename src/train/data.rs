@@ -152,9 +152,9 @@ impl TileSet {
 
     /// The relief hint of this set: `relief_z` (as the conditioning vector holds it) regressed
     /// on the context statistics of [`HINT_CROPS`] fixed crops. Deterministic.
-    pub fn relief_hint(&self, crop: usize, norm: &Normalisation) -> Option<ReliefHint> {
+    pub fn relief_hint(&self, crop: usize, norm: &Normalisation, features: usize) -> Option<ReliefHint> {
         let (x, z) = self.relief_samples(crop, norm);
-        ReliefHint::fit(&x, &z)
+        ReliefHint::fit(&x, &z, features)
     }
 
     /// Context features and true `relief_z` of [`HINT_CROPS`] fixed crops: what the hint is
@@ -323,8 +323,8 @@ mod tests {
             .collect();
         let set = TileSet { tiles, checksums: Vec::new() };
         let norm = set.normalisation(32, 0.5);
-        let hint = set.relief_hint(32, &norm).expect("well-posed");
-        assert_eq!(set.relief_hint(32, &norm), Some(hint.clone()), "the fit is deterministic");
+        let hint = set.relief_hint(32, &norm, FEATURES).expect("well-posed");
+        assert_eq!(set.relief_hint(32, &norm, FEATURES), Some(hint.clone()), "the fit is deterministic");
         assert!(hint.r2 > 0.8, "R² {}", hint.r2);
         let low = |t: &EncodedTile| crop_of(t, 10, 20, 32, 0, |t, k| t.low[k]);
         let (gentle, rough) = (hint.predict(&low(&set.tiles[0]), 32), hint.predict(&low(&set.tiles[5]), 32));

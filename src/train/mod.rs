@@ -38,6 +38,7 @@ use self::data::{read_split, Batch, TileSet};
 use crate::cli::Failure;
 use infiniterra_terrain::encoding::ContextSpec;
 use infiniterra_terrain::model::burn;
+use infiniterra_terrain::model::hint;
 
 /// Arguments of `infiniterra train`.
 #[derive(Debug, Clone, clap::Args)]
@@ -126,6 +127,11 @@ pub struct TrainArgs {
     /// `<out>/<stage>.json` on the stage's training data and write it into that manifest.
     #[arg(long)]
     pub fit_relief_hint: bool,
+    /// Fit the relief hint (when training ships, or with `--fit-relief-hint`) on the four
+    /// statistics of the window's 8 km blocks too (held-out R² 0.93 instead of 0.88; the
+    /// shipped core's hint is fitted without them).
+    #[arg(long)]
+    pub hint_block_statistics: bool,
     /// Instead of training: choose the relief hint's offset of the shipped `<out>/<stage>.json`
     /// by generating `--tiles` training tiles for a grid of offsets and scoring each set with
     /// the realism bar (minutes), and write it into that manifest.
@@ -156,6 +162,17 @@ pub struct TrainArgs {
     /// Use a very small network and no data files (smoke tests of the training machinery).
     #[arg(long, hide = true)]
     pub smoke: bool,
+}
+
+impl TrainArgs {
+    /// How many of [`hint::KNOWN_FEATURES`] a new relief-hint fit uses.
+    fn hint_features(&self) -> usize {
+        if self.hint_block_statistics {
+            hint::FEATURES
+        } else {
+            hint::BASE_FEATURES
+        }
+    }
 }
 
 fn parse_precision(s: &str) -> Result<Precision, String> {
@@ -246,7 +263,7 @@ fn stage_data(stage: &str, dir: &Path, spec: ContextSpec) -> Result<(TileSet, Ti
 /// Fits the relief hint of the shipped `<models>/<stage>.json` on the stage's training data
 /// (the crops and normalisation it was trained with) and writes it into the manifest; the
 /// weights are untouched. Training does the same when it ships.
-fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()> {
+fn fit_relief_hint(models: &Path, stage: &str, data: &Path, features: usize) -> anyhow::Result<()> {
     let path = models.join(format!("{stage}.json"));
     let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let manifest: ModelManifest =
@@ -254,7 +271,7 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path) -> anyhow::Result<()
     let (train, heldout) = stage_data(stage, data, manifest.context).map_err(|e| anyhow!(e))?;
     let (crop, norm) = (manifest.training.crop, &manifest.normalisation);
     let hint = train
-        .relief_hint(crop, norm)
+        .relief_hint(crop, norm, features)
         .ok_or_else(|| anyhow!("{}: the relief-hint fit is singular on this data", data.display()))?;
     println!(
         "relief hint of {}: coefficients {:?} on {:?}, R² {:.3}",
@@ -350,7 +367,7 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
             .map_err(Failure::runtime);
     }
     if args.fit_relief_hint {
-        return fit_relief_hint(&args.out, &args.stage, &args.data).map_err(Failure::runtime);
+        return fit_relief_hint(&args.out, &args.stage, &args.data, args.hint_features()).map_err(Failure::runtime);
     }
     if args.calibrate_relief_response {
         let seed = seed.unwrap_or(DEFAULT_SEED);
@@ -693,7 +710,8 @@ impl Trainer {
         manifest.context = self.spec.context;
         manifest.context_projection = self.spec.projection.clone();
         manifest.normalisation = self.state.normalisation.clone();
-        manifest.relief_hint = self.train.relief_hint(self.state.crop, &self.state.normalisation);
+        manifest.relief_hint =
+            self.train.relief_hint(self.state.crop, &self.state.normalisation, self.args.hint_features());
         manifest.training = TrainingRecord {
             steps: self.state.step,
             batch: self.state.batch,

@@ -28,6 +28,7 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
         draws: 1,
         counterpart: None,
         fit_relief_hint: false,
+        hint_block_statistics: false,
         calibrate_relief_hint: false,
         calibrate_relief_response: false,
         calibrate_spectrum: false,

@@ -4,6 +4,9 @@
 //! whose Fourier amplitudes fall as k⁻¹ (2-D "brown" noise) has β = −2; real 1 km DEMs sit
 //! near β ≈ −2.8…−3.1 (fBm with Hurst exponent H has β = −2 − 2H).
 
+use rand_chacha::rand_core::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
 use super::fft::{fft2, Complex};
 use super::Raster;
 
@@ -104,6 +107,38 @@ pub fn fit_beta(s: &Spectrum) -> f64 {
     sxy / sxx
 }
 
+/// Resamples [`beta_sampling_sd`] draws: enough that the estimate's own scatter is a few per cent.
+pub const BOOTSTRAP_RESAMPLES: usize = 400;
+
+/// How far the β of the mean of `spectra` moves with the choice of tiles: the standard
+/// deviation of [`fit_beta`] over [`BOOTSTRAP_RESAMPLES`] bootstrap resamples of the tiles
+/// (drawn with replacement from a fixed ChaCha stream, so a report is reproducible). A set's
+/// mean spectrum is dominated by its few most rugged tiles, so this is large next to most
+/// distances the report prints; it is the β-estimate's standard error, not a tolerance. NaN
+/// for fewer than two spectra or spectra of different rings.
+pub fn beta_sampling_sd(spectra: &[Spectrum]) -> f64 {
+    let n = spectra.len();
+    if n < 2 || spectra.iter().any(|s| s.frequency != spectra[0].frequency) {
+        return f64::NAN;
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_b00f);
+    let rings = spectra[0].power.len();
+    let betas: Vec<f64> = (0..BOOTSTRAP_RESAMPLES)
+        .map(|_| {
+            let mut power = vec![0.0; rings];
+            for _ in 0..n {
+                let pick = &spectra[(rng.next_u64() % n as u64) as usize];
+                power.iter_mut().zip(&pick.power).for_each(|(p, q)| *p += q / n as f64);
+            }
+            fit_beta(&Spectrum { frequency: spectra[0].frequency.clone(), power })
+        })
+        .filter(|b| b.is_finite())
+        .collect();
+    let m = betas.len().max(1) as f64;
+    let mean = betas.iter().sum::<f64>() / m;
+    (betas.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / m).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -152,5 +187,21 @@ mod tests {
         assert!((s.frequency[0] - 1.0 / (32.0 * 250.0)).abs() < 1e-15);
         assert!(s.power.iter().all(|p| *p < 1e-12), "a plane is removed entirely: {:?}", s.power);
         assert!(Spectrum::mean(&[s.clone(), s.clone()]).is_some_and(|m| m == s));
+    }
+
+    #[test]
+    fn the_bootstrap_sd_grows_with_the_spread_between_tiles() {
+        let frequency: Vec<f64> = (1..=32).map(|r| r as f64 / 64_000.0).collect();
+        // Power laws that cross mid-band, so the mix's slope depends on how many of each it holds.
+        let tile = |beta: f64| Spectrum {
+            frequency: frequency.clone(),
+            power: frequency.iter().map(|f| (f / frequency[8]).powf(beta)).collect(),
+        };
+        let alike: Vec<Spectrum> = (0..40).map(|i| tile(-2.8 + 0.001 * (i % 2) as f64)).collect();
+        let mixed: Vec<Spectrum> = (0..40).map(|i| tile(if i % 2 == 0 { -2.4 } else { -3.2 })).collect();
+        let (a, m) = (beta_sampling_sd(&alike), beta_sampling_sd(&mixed));
+        assert!(a < 1e-3 && m > 0.02, "identical tiles {a}, mixed tiles {m}");
+        assert_eq!(beta_sampling_sd(&mixed), m, "a fixed stream: the same answer every time");
+        assert!(beta_sampling_sd(&mixed[..1]).is_nan());
     }
 }

@@ -24,12 +24,14 @@ pub const KNOWN_FEATURES: [&str; 8] = [
     "land_fraction_blocks",
     "ln_median_gradient_blocks",
 ];
-/// Number of features a new fit uses (a constant included).
+/// Number of features a fit can use (a constant included).
 pub const FEATURES: usize = KNOWN_FEATURES.len();
-/// Names of the features a new fit uses, in coefficient order, for the manifest and logs: all
-/// of them. The first four alone explain 86–88 % of the variance of the core's `relief_z`
-/// (training / held-out windows); with the block statistics 90–92 %, the rms error falling
-/// from 0.35 to 0.28 z on held-out land (measured in Python on 4,000 crops each).
+/// The leading features a fit uses unless asked for the block statistics: the shipped core's.
+pub const BASE_FEATURES: usize = 4;
+/// Names of the features a fit may use, in coefficient order, for the manifest and logs. The
+/// first [`BASE_FEATURES`] (the shipped core's hint) explain 86–88 % of the variance of the
+/// core's `relief_z` (training / held-out windows); with the block statistics 90–93 %, the rms
+/// error falling from 0.355 to 0.275 z on held-out land (4,000 crops each).
 pub const FEATURE_NAMES: [&str; FEATURES] = KNOWN_FEATURES;
 /// Side of the blocks the `*_blocks` statistics average the low band over, pixels: the core's
 /// context cell, so the statistics see the 8 km grid the pipeline conditions on (for other
@@ -147,15 +149,17 @@ fn feature_indices(names: &[String]) -> Option<Vec<usize>> {
 }
 
 impl ReliefHint {
-    /// Least-squares fit of `targets` on the feature rows `x` (all of [`FEATURE_NAMES`]).
+    /// Least-squares fit of `targets` on the first `count` features of the rows `x` (see
+    /// [`FEATURE_NAMES`]; [`BASE_FEATURES`] or [`FEATURES`]).
     /// Features that do not vary over the samples (every block above sea level, say) are left
     /// out of the fit and of the hint, so they cannot make the system singular. `None` when
     /// nothing but the constant varies, or the rest is degenerate (collinear).
-    pub fn fit(x: &[[f64; FEATURES]], targets: &[f64]) -> Option<ReliefHint> {
+    pub fn fit(x: &[[f64; FEATURES]], targets: &[f64], count: usize) -> Option<ReliefHint> {
         assert_eq!(x.len(), targets.len());
         let first = x.first()?;
-        let used: Vec<usize> =
-            (0..FEATURES).filter(|&i| i == 0 || x.iter().any(|row| (row[i] - first[i]).abs() > 1e-12)).collect();
+        let used: Vec<usize> = (0..count.min(FEATURES))
+            .filter(|&i| i == 0 || x.iter().any(|row| (row[i] - first[i]).abs() > 1e-12))
+            .collect();
         if used.len() < 2 {
             return None;
         }
@@ -301,7 +305,7 @@ mod tests {
         let x: Vec<[f64; FEATURES]> = windows.iter().map(|w| features(w, side)).collect();
         let truth = [0.5, -2.0, 1.5, 0.25];
         let y: Vec<f64> = x.iter().map(|f| f.iter().zip(&truth).map(|(a, b)| a * b).sum()).collect();
-        let hint = ReliefHint::fit(&x, &y).expect("well-posed");
+        let hint = ReliefHint::fit(&x, &y, FEATURES).expect("well-posed");
         for (c, t) in hint.coefficients.iter().zip(truth) {
             assert!((c - t).abs() < 1e-6, "{:?} vs {truth:?}", hint.coefficients);
         }
@@ -312,6 +316,11 @@ mod tests {
         assert!((check.bias - 0.5).abs() < 1e-6 && (check.rms - 0.5).abs() < 1e-6, "{check:?}");
         assert!((hint.predict(&windows[7], side) as f64 - y[7]).abs() < 1e-4);
         hint.validate().expect("fresh fit is valid");
+        // Asked for fewer, the fit uses only the leading features (side 16: the block
+        // statistics are constant here, so both fits use the first four).
+        let base = ReliefHint::fit(&x, &y, BASE_FEATURES).expect("well-posed");
+        assert_eq!(base.features, FEATURE_NAMES[..BASE_FEATURES]);
+        assert_eq!(ReliefHint::fit(&x, &y, 2).expect("two features").features, ["1", "mean_low"]);
         // The calibration offset shifts every prediction by itself, nothing else.
         let shifted = ReliefHint { offset: 0.75, ..hint.clone() };
         assert!((shifted.predict(&windows[7], side) - hint.predict(&windows[7], side) - 0.75).abs() < 1e-5);
@@ -341,7 +350,7 @@ mod tests {
     fn a_degenerate_sample_set_is_refused_and_a_foreign_manifest_entry_is_named() {
         let flat = vec![3.0f32; 64];
         let x = vec![features(&flat, 8); 10];
-        assert_eq!(ReliefHint::fit(&x, &[1.0; 10]), None);
+        assert_eq!(ReliefHint::fit(&x, &[1.0; 10], FEATURES), None);
         let bad = ReliefHint {
             features: vec!["1".into(), "ln_roughness_of_something_else".into()],
             coefficients: vec![0.0; 2],
