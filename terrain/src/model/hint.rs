@@ -11,6 +11,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::encoding::box_downsample;
+
 /// Every context statistic this build can compute, in the order [`features`] returns them. A
 /// manifest's hint names the ones it was fitted on, so a hint fitted on fewer (an older fit)
 /// keeps working.
@@ -77,7 +79,7 @@ pub struct HintCheck {
 /// The context statistics of one square window of side `side`: its low band in signed-sqrt
 /// units (√m), as the model's conditioning channel holds it before normalisation. All of
 /// [`KNOWN_FEATURES`], in that order. The block statistics read the means of [`BLOCK`]-sided
-/// blocks (0 where the window holds fewer than 3×3 of them).
+/// blocks (0 where the window holds fewer than 3×3 of them or is not made of whole blocks).
 pub fn features(low: &[f32], side: usize) -> [f64; FEATURES] {
     assert_eq!(low.len(), side * side);
     let n = low.len() as f64;
@@ -102,17 +104,10 @@ pub fn features(low: &[f32], side: usize) -> [f64; FEATURES] {
 /// first and last see it; the window's standard deviation and mean gradient do not.
 fn block_statistics(low: &[f32], side: usize) -> [f64; 4] {
     let k = side / BLOCK;
-    if k < 3 {
+    if k < 3 || side % BLOCK != 0 {
         return [0.0; 4];
     }
-    let mut c = vec![0.0f64; k * k];
-    for y in 0..k * BLOCK {
-        for x in 0..k * BLOCK {
-            c[(y / BLOCK) * k + x / BLOCK] += low[y * side + x] as f64;
-        }
-    }
-    let area = (BLOCK * BLOCK) as f64;
-    c.iter_mut().for_each(|v| *v /= area);
+    let c: Vec<f64> = box_downsample(low, side, side, BLOCK).into_iter().map(f64::from).collect();
     let at = |y: usize, x: usize| c[y * k + x];
     let mut laplacian = 0.0;
     for y in 1..k - 1 {
