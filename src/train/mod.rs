@@ -165,7 +165,7 @@ pub struct TrainArgs {
 }
 
 impl TrainArgs {
-    /// How many of [`hint::KNOWN_FEATURES`] a new relief-hint fit uses.
+    /// How many of [`hint::FEATURE_NAMES`] a new relief-hint fit uses.
     fn hint_features(&self) -> usize {
         if self.hint_block_statistics {
             hint::FEATURES

@@ -13,10 +13,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::encoding::box_downsample;
 
-/// Every context statistic this build can compute, in the order [`features`] returns them. A
-/// manifest's hint names the ones it was fitted on, so a hint fitted on fewer (an older fit)
-/// keeps working.
-pub const KNOWN_FEATURES: [&str; 8] = [
+/// Every context statistic this build can compute, in the order [`features`] returns them, by
+/// the names the manifest and logs use. A manifest's hint names the ones it was fitted on, so
+/// a hint fitted on fewer (an older fit) keeps working. The first [`BASE_FEATURES`] (the
+/// shipped core's hint) explain 86–88 % of the variance of the core's `relief_z` (training /
+/// held-out windows); with the block statistics 90–93 %, the rms error falling from 0.355 to
+/// 0.275 z on held-out land (4,000 crops each).
+pub const FEATURE_NAMES: [&str; 8] = [
     "1",
     "mean_low",
     "ln_std_low",
@@ -27,14 +30,9 @@ pub const KNOWN_FEATURES: [&str; 8] = [
     "ln_median_gradient_blocks",
 ];
 /// Number of features a fit can use (a constant included).
-pub const FEATURES: usize = KNOWN_FEATURES.len();
+pub const FEATURES: usize = FEATURE_NAMES.len();
 /// The leading features a fit uses unless asked for the block statistics: the shipped core's.
 pub const BASE_FEATURES: usize = 4;
-/// Names of the features a fit may use, in coefficient order, for the manifest and logs. The
-/// first [`BASE_FEATURES`] (the shipped core's hint) explain 86–88 % of the variance of the
-/// core's `relief_z` (training / held-out windows); with the block statistics 90–93 %, the rms
-/// error falling from 0.355 to 0.275 z on held-out land (4,000 crops each).
-pub const FEATURE_NAMES: [&str; FEATURES] = KNOWN_FEATURES;
 /// Side of the blocks the `*_blocks` statistics average the low band over, pixels: the core's
 /// context cell, so the statistics see the 8 km grid the pipeline conditions on (for other
 /// stages simply a coarser view of their low band).
@@ -43,7 +41,7 @@ pub const BLOCK: usize = 8;
 /// A linear predictor of the relief entry of the conditioning vector.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReliefHint {
-    /// What each coefficient multiplies (names from [`KNOWN_FEATURES`]).
+    /// What each coefficient multiplies (names from [`FEATURE_NAMES`]).
     pub features: Vec<String>,
     /// One coefficient per feature.
     pub coefficients: Vec<f64>,
@@ -78,7 +76,7 @@ pub struct HintCheck {
 
 /// The context statistics of one square window of side `side`: its low band in signed-sqrt
 /// units (√m), as the model's conditioning channel holds it before normalisation. All of
-/// [`KNOWN_FEATURES`], in that order. The block statistics read the means of [`BLOCK`]-sided
+/// [`FEATURE_NAMES`], in that order. The block statistics read the means of [`BLOCK`]-sided
 /// blocks (0 where the window holds fewer than 3×3 of them or is not made of whole blocks).
 pub fn features(low: &[f32], side: usize) -> [f64; FEATURES] {
     assert_eq!(low.len(), side * side);
@@ -138,9 +136,9 @@ fn block_statistics(low: &[f32], side: usize) -> [f64; 4] {
     [(laplacian + 1e-3).ln(), (max_abs + 1.0).ln(), land, (median + 1e-3).ln()]
 }
 
-/// Index into [`KNOWN_FEATURES`] of each named feature; `None` for a name this build does not know.
+/// Index into [`FEATURE_NAMES`] of each named feature; `None` for a name this build does not know.
 fn feature_indices(names: &[String]) -> Option<Vec<usize>> {
-    names.iter().map(|name| KNOWN_FEATURES.iter().position(|k| k == name)).collect()
+    names.iter().map(|name| FEATURE_NAMES.iter().position(|k| k == name)).collect()
 }
 
 impl ReliefHint {
@@ -226,8 +224,16 @@ impl ReliefHint {
 
     /// The linear combination of this hint's features out of a row of all of them.
     fn combine(&self, all: &[f64; FEATURES]) -> f64 {
-        let indices = feature_indices(&self.features).expect("validated: every feature is known");
-        indices.iter().zip(&self.coefficients).map(|(&i, c)| all[i] * c).sum::<f64>()
+        // Looked up by name on every call (eight string compares at most, no allocation): a
+        // window's network evaluation costs milliseconds, this nanoseconds.
+        self.features
+            .iter()
+            .zip(&self.coefficients)
+            .map(|(name, c)| {
+                let i = FEATURE_NAMES.iter().position(|k| k == name).expect("validated: every feature is known");
+                all[i] * c
+            })
+            .sum::<f64>()
     }
 
     /// What the network is asked for in a window whose low band is `low` (side `side`): the
@@ -255,7 +261,7 @@ impl ReliefHint {
         if feature_indices(&self.features).is_none() || self.features.is_empty() {
             return Err(format!(
                 "relief_hint.features = {:?}: each must be one this build computes, {:?}",
-                self.features, KNOWN_FEATURES
+                self.features, FEATURE_NAMES
             ));
         }
         if self.coefficients.len() != self.features.len() || self.coefficients.iter().any(|c| !c.is_finite()) {
@@ -366,7 +372,7 @@ mod tests {
             (0..side * side).map(|i| 20.0 + ((i % side) as f32 * 0.2).sin() * (i / side) as f32 * 0.3).collect();
         let all = features(&low, side);
         let old = ReliefHint {
-            features: KNOWN_FEATURES[..4].iter().map(|s| s.to_string()).collect(),
+            features: FEATURE_NAMES[..4].iter().map(|s| s.to_string()).collect(),
             coefficients: vec![3.0, -0.19, -0.62, 1.47],
             ..Default::default()
         };
