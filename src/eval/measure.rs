@@ -33,6 +33,8 @@ pub struct SetMetrics {
     pub beta: f64,
     /// Standard error of `beta` from the choice of tiles (bootstrap over the tiles).
     pub beta_sd: f64,
+    /// Each tile's spectrum (those of the modal size): what the real-vs-real splits deal out.
+    pub spectra: Vec<Spectrum>,
     /// Pooled depression statistics.
     pub depressions: Depressions,
     /// Pooled seam sums.
@@ -95,6 +97,7 @@ pub fn measure(tiles: &[Raster], lines: SeamLines, progress: &mut dyn FnMut(u64,
         beta: spectrum.as_ref().map_or(f64::NAN, fit_beta),
         beta_sd,
         spectrum,
+        spectra: same,
         depressions: drainage,
         seams,
     }

@@ -20,7 +20,7 @@ use image::Rgb;
 
 pub use data::DataArgs;
 pub use input::{Heightmap, Reference};
-pub use report::{Report, Target};
+pub use report::{BetaSplits, Report, Target, SPECTRAL_SLOPE_KEY};
 
 use crate::terrain::metrics::{fbm, Raster, SeamLines, FBM_BETA};
 use crate::terrain::pipeline::MODEL_PIXEL_METRES;
@@ -172,6 +172,16 @@ fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
     for t in &report.targets {
         realism.insert(t.key.clone(), serde_json::json!(t.value));
         realism.insert(format!("{}_met", t.key), serde_json::json!(if t.pass { 1.0 } else { 0.0 }));
+    }
+    // What real land scores on the same lines, kept beside the model's numbers so a reader can
+    // tell a line the model misses from one that real terrain misses too.
+    let real_met = report.real_land.iter().filter(|t| t.pass).count();
+    realism.insert("real_land_lines_met".into(), serde_json::json!(real_met as f64));
+    if let Some(b) = &report.beta_splits {
+        realism.insert("real_split_abs_delta_beta_median".into(), serde_json::json!(b.median));
+        realism.insert("real_split_abs_delta_beta_p90".into(), serde_json::json!(b.p90));
+        realism.insert("real_split_within_spectral_line".into(), serde_json::json!(b.within_line));
+        realism.insert("real_split_farther_than_generated".into(), serde_json::json!(b.farther_than_generated));
     }
     crate::manifest_edit::edit_manifest(path, |object| {
         object.insert("realism".into(), serde_json::Value::Object(realism));

@@ -6,10 +6,13 @@ use image::Rgb;
 
 use super::measure::SetMetrics;
 use super::plot::{Panel, Series};
-use crate::terrain::metrics::{chi2_distance, histogram, quantile_edges, wasserstein1};
+use crate::terrain::metrics::{chi2_distance, histogram, quantile_edges, real_split_distances, wasserstein1};
 
 /// Quantile bins of the style histograms (fixed on the held-out reference).
 pub const STYLE_BINS: usize = 20;
+
+/// Key of the realism bar's spectral-slope line.
+pub const SPECTRAL_SLOPE_KEY: &str = "spectral_slope_abs_delta";
 
 /// One column of the report: a set of tiles and how it is drawn.
 pub struct Column {
@@ -32,6 +35,53 @@ pub struct Report {
     pub rows: Vec<(String, Vec<String>)>,
     /// The realism bar of the learned terrain, when the real-vs-real floor is known.
     pub targets: Vec<Target>,
+    /// The same lines with the training land (real) in place of the generated terrain: which of
+    /// them real land itself meets.
+    pub real_land: Vec<Target>,
+    /// How far apart in β random sets of real tiles lie, when the floor is known.
+    pub beta_splits: Option<BetaSplits>,
+}
+
+/// The spectral-slope distance between real sets by the choice of tiles alone
+/// ([`real_split_distances`]): held-out and training tiles pooled and dealt at random into a
+/// set the reference's size and the rest.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BetaSplits {
+    /// Partitions drawn.
+    pub splits: usize,
+    /// Tiles in the first set of each partition (the reference's count) and in the second.
+    pub sizes: (usize, usize),
+    /// Median |Δβ| over the partitions.
+    pub median: f64,
+    /// 90th percentile of |Δβ|.
+    pub p90: f64,
+    /// The realism bar's spectral line.
+    pub line: f64,
+    /// Fraction of partitions whose |Δβ| is within the line.
+    pub within_line: f64,
+    /// The generated terrain's |Δβ| to the reference.
+    pub generated: f64,
+    /// Fraction of partitions whose |Δβ| is larger than the generated terrain's: real sets
+    /// that lie farther apart than the model lies from the reference.
+    pub farther_than_generated: f64,
+}
+
+impl BetaSplits {
+    fn new(reference: &SetMetrics, train: &SetMetrics, line: &Target) -> Option<BetaSplits> {
+        let d = real_split_distances(&reference.spectra, &train.spectra);
+        let quantile = |q: f64| d[((d.len() - 1) as f64 * q).round() as usize];
+        let share = |keep: &dyn Fn(f64) -> bool| d.iter().filter(|&&x| keep(x)).count() as f64 / d.len() as f64;
+        (!d.is_empty()).then(|| BetaSplits {
+            splits: d.len(),
+            sizes: (reference.spectra.len(), train.spectra.len()),
+            median: quantile(0.5),
+            p90: quantile(0.9),
+            line: line.high,
+            within_line: share(&|x| x <= line.high),
+            generated: line.value,
+            farther_than_generated: share(&|x| x > line.value),
+        })
+    }
 }
 
 /// One line of the realism bar (issue #4): a generated number and the range it must lie in.
@@ -70,12 +120,9 @@ impl Target {
     }
 }
 
-/// The realism bar from columns (reference, generated, fBm, train (real)).
-fn targets(columns: &[Column], slope_edges: &[f64], relief_edges: &[f64]) -> Vec<Target> {
-    let [reference, generated, fbm, train] = match columns {
-        [r, g, f, t] => [&r.metrics, &g.metrics, &f.metrics, &t.metrics],
-        _ => return Vec::new(),
-    };
+/// The realism bar of `generated` (or any set judged in its place) against `reference`, with
+/// `train` (other real tiles) as the real-vs-real floor and `fbm` as the procedural baseline.
+fn bar([reference, generated, fbm, train]: [&SetMetrics; 4], slope_edges: &[f64], relief_edges: &[f64]) -> Vec<Target> {
     let slope_ref = histogram(&reference.slopes, slope_edges);
     let relief_ref = histogram(&reference.relief, relief_edges);
     type Distance = fn(&SetMetrics, &SetMetrics, &[f64], &[f64], &[f64], &[f64]) -> f64;
@@ -84,7 +131,7 @@ fn targets(columns: &[Column], slope_edges: &[f64], relief_edges: &[f64]) -> Vec
         ("slope_chi2", |m, _, se, sr, _, _| chi2_distance(&histogram(&m.slopes, se), sr)),
         ("relative_elevation_w1_m", |m, r, _, _, _, _| wasserstein1(&m.relief, &r.relief)),
         ("relative_elevation_chi2", |m, _, _, _, re, rr| chi2_distance(&histogram(&m.relief, re), rr)),
-        ("spectral_slope_abs_delta", |m, r, _, _, _, _| (m.beta - r.beta).abs()),
+        (SPECTRAL_SLOPE_KEY, |m, r, _, _, _, _| (m.beta - r.beta).abs()),
     ];
     let mut out: Vec<Target> = metrics
         .iter()
@@ -161,8 +208,20 @@ impl Report {
             ("fill volume per area (m³/km²)".into(), value(&|m| cell(m.depressions.volume_per_km2(), 0))),
             (format!("seam ratio ({seam_caption})"), value(&|m| cell(m.seams.ratio(), 3))),
         ];
-        let targets = targets(columns, &slope_edges, &relief_edges);
-        Report { notes, columns: columns.iter().map(|c| c.label.clone()).collect(), rows, targets }
+        let (targets, real_land, beta_splits) = match columns {
+            [r, g, f, t] => {
+                let [r, g, f, t] = [&r.metrics, &g.metrics, &f.metrics, &t.metrics];
+                let targets = bar([r, g, f, t], &slope_edges, &relief_edges);
+                // Real land judged as if it were generated: the train split against the held-out.
+                let real_land = bar([r, t, f, t], &slope_edges, &relief_edges);
+                let splits =
+                    targets.iter().find(|x| x.key == SPECTRAL_SLOPE_KEY).and_then(|l| BetaSplits::new(r, t, l));
+                (targets, real_land, splits)
+            }
+            _ => (Vec::new(), Vec::new(), None),
+        };
+        let labels = columns.iter().map(|c| c.label.clone()).collect();
+        Report { notes, columns: labels, rows, targets, real_land, beta_splits }
     }
 
     /// The cell of `metric` in column `column`, if both exist (for tests and scripts).
@@ -202,6 +261,39 @@ impl fmt::Display for Report {
                 let verdict = if t.pass { "met" } else { "NOT met" };
                 writeln!(f, "  {:<26} {:>12.4}  {:<8} {}", t.key, t.value, verdict, t.rule)?;
             }
+        }
+        if !self.real_land.is_empty() {
+            let passed = self.real_land.iter().filter(|t| t.pass).count();
+            let missed: Vec<String> =
+                self.real_land.iter().filter(|t| !t.pass).map(|t| format!("{} {:.4}", t.key, t.value)).collect();
+            write!(
+                f,
+                "the same lines for real land (train split in place of generated): {passed}/{} met",
+                self.real_land.len()
+            )?;
+            if missed.is_empty() {
+                writeln!(f)?;
+            } else {
+                writeln!(f, "; NOT met: {}", missed.join(", "))?;
+            }
+        }
+        if let Some(b) = &self.beta_splits {
+            writeln!(
+                f,
+                "real vs real by chance: {} random splits of the {} real tiles into {} + {}: |Δβ| median {:.3}, \
+                 90th percentile {:.3}; within the line {:.3} in {:.0} % of them; farther apart than the \
+                 generated terrain's {:.3} in {:.0} %",
+                b.splits,
+                b.sizes.0 + b.sizes.1,
+                b.sizes.0,
+                b.sizes.1,
+                b.median,
+                b.p90,
+                b.line,
+                100.0 * b.within_line,
+                b.generated,
+                100.0 * b.farther_than_generated
+            )?;
         }
         Ok(())
     }

@@ -76,6 +76,23 @@ fn the_realism_bar_passes_real_terrain_fails_rougher_terrain_and_is_recorded_in_
     assert_eq!(written["realism"]["slope_w1_deg"], 0.0);
     assert_eq!(written["realism"]["slope_w1_deg_met"], 1.0);
     assert!(written["realism"].get("old").is_none(), "old numbers are replaced");
+    // Beside the bar: real land on the same lines, and real-vs-real splits of the spectral slope.
+    assert_eq!(report.real_land.len(), report.targets.len());
+    let real_slope = report.real_land.iter().find(|t| t.key == "slope_w1_deg").expect("slope line for real land");
+    assert_eq!(
+        Some(format!("{:.2}", real_slope.value).as_str()),
+        report.get("slope W1", 3),
+        "the train column's distance"
+    );
+    let splits = report.beta_splits.as_ref().expect("a train split gives real-vs-real splits");
+    assert_eq!(splits.sizes, (3, 3));
+    assert!(splits.median <= splits.p90 && (0.0..=1.0).contains(&splits.within_line), "{splits:?}");
+    // Generated = the reference itself, at distance 0: real sets of different hills lie farther apart.
+    assert_eq!(splits.generated, 0.0);
+    assert!(splits.farther_than_generated > 0.9, "{splits:?}");
+    assert!(report.to_string().contains("real vs real by chance"), "{report}");
+    assert_eq!(written["realism"]["real_land_lines_met"], report.real_land.iter().filter(|t| t.pass).count() as f64);
+    assert_eq!(written["realism"]["real_split_abs_delta_beta_median"], splits.median);
 
     // Ten times the relief: slopes far off, the bar is not met.
     let rough = dir.path().join("rough.npy");

@@ -19,15 +19,13 @@ use infiniterra_terrain::model::{load_model, ComputeBackend, DepressionInfill};
 
 use super::calibrate::{best, score, BarSets, Trial};
 use super::data::read_split;
+use crate::eval::SPECTRAL_SLOPE_KEY;
 
 /// Depth scales tried after "off", metres, deepest first, halving: from about the depth of
 /// real closed basins 30–60 km across at 1 km (60 m on held-out land, 16–32 km ones 40 m)
 /// down to a few metres. All are tried: the fill-volume line is met only by the shallower
 /// ones, while the slope lines drift the other way, so the score is not monotone.
 pub const DEPTH_SCALES_M: [f64; 5] = [80.0, 40.0, 20.0, 10.0, 5.0];
-
-/// The realism bar's line that the spectral equaliser, not the infill, answers for.
-pub const SPECTRAL_LINE: &str = "spectral_slope_abs_delta";
 
 /// "off" for `None`, the depth scale otherwise.
 fn label(depth: Option<f64>) -> String {
@@ -58,7 +56,7 @@ pub fn run(
         model.manifest.depression_infill = depth.map(|c| DepressionInfill { depth_scale_m: c });
         let mut targets = sets
             .judge(&model, &device, seed, |i| eprint!("\r  depth scale {}: tile {}/{count}   ", label(depth), i + 1));
-        targets.retain(|t| t.key != SPECTRAL_LINE);
+        targets.retain(|t| t.key != SPECTRAL_SLOPE_KEY); // the equaliser's line, not the infill's
         let trial = Trial {
             offset: depth.unwrap_or(f64::INFINITY),
             met: targets.iter().filter(|t| t.pass).count(),

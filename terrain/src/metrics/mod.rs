@@ -24,4 +24,4 @@ pub use raster::Raster;
 pub use relief::{relative_elevation, RELIEF_RADIUS};
 pub use seams::{seam_ratio, SeamLines, SeamStats};
 pub use slope::slope_degrees;
-pub use spectrum::{beta_sampling_sd, fit_beta, radial_power_spectrum, Spectrum};
+pub use spectrum::{beta_sampling_sd, fit_beta, radial_power_spectrum, real_split_distances, Spectrum, REAL_SPLITS};
