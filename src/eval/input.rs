@@ -14,6 +14,66 @@ use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
 /// Tile side when neither file says (the prepared sets' size).
 pub const DEFAULT_TILE: usize = 256;
 
+/// Side, in tiles, of the squares a prepared set's held-out region is made of (its manifest's
+/// `heldout_region`): the tiles of one square are neighbours, alike, and held out together.
+pub const REGION_SQUARE_TILES: i64 = 2;
+
+/// The part of a prepared set's `manifest.json` that places its tiles.
+#[derive(Debug, Deserialize)]
+struct SetManifest {
+    tiles: Vec<TileEntry>,
+}
+
+/// One tile of a prepared set: its split, its place in the set's tile grid, its index in the split.
+#[derive(Debug, Deserialize)]
+struct TileEntry {
+    split: String,
+    row: i64,
+    col: i64,
+    index: usize,
+}
+
+/// Which square of [`REGION_SQUARE_TILES`] tiles each tile of a prepared set lies in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Regions {
+    /// One key per held-out tile, in the split's order.
+    pub heldout: Vec<u64>,
+    /// One key per training tile, in the split's order.
+    pub train: Vec<u64>,
+}
+
+impl Regions {
+    /// Reads `manifest.json` of a prepared set whose splits hold `counts` = (held-out, train)
+    /// tiles; `None` when the set has no manifest.
+    fn load(dir: &Path, counts: (usize, usize)) -> Result<Option<Regions>, EvalError> {
+        let path = dir.join("manifest.json");
+        let Ok(text) = std::fs::read_to_string(&path) else { return Ok(None) };
+        let bad = |why: String| EvalError::Input(format!("{}: {why}", path.display()));
+        let manifest: SetManifest =
+            serde_json::from_str(&text).map_err(|e| bad(format!("not a prepared set's manifest: {e}")))?;
+        let keys = |split: &str, count: usize| -> Result<Vec<u64>, EvalError> {
+            let mut keys = vec![None; count];
+            for t in manifest.tiles.iter().filter(|t| t.split == split) {
+                let square = (t.row.div_euclid(REGION_SQUARE_TILES), t.col.div_euclid(REGION_SQUARE_TILES));
+                let slot = keys.get_mut(t.index).ok_or_else(|| {
+                    bad(format!("{split} tile index {} is beyond the split's {count} tiles", t.index))
+                })?;
+                *slot = Some(((square.0 as u64) << 32) ^ (square.1 as u32 as u64));
+            }
+            keys.into_iter()
+                .enumerate()
+                .map(|(i, k)| k.ok_or_else(|| bad(format!("lists no {split} tile with index {i}"))))
+                .collect()
+        };
+        Ok(Some(Regions { heldout: keys("heldout", counts.0)?, train: keys("train", counts.1)? }))
+    }
+
+    /// The keys of held-out then training tiles, as the real-vs-real splits pool them.
+    pub fn pooled(&self) -> Vec<u64> {
+        self.heldout.iter().chain(&self.train).copied().collect()
+    }
+}
+
 /// The sidecar fields `eval` reads: export sidecars and prepared-set sidecars both have
 /// `metres_per_pixel`; a stack of tiles says `tile`; an export says where it lies.
 #[derive(Debug, Deserialize)]
@@ -124,6 +184,8 @@ pub struct Reference {
     pub train: Option<Heightmap>,
     /// Tile side the metrics use.
     pub tile: usize,
+    /// Where a prepared set's tiles lie (from its manifest), when it says.
+    pub regions: Option<Regions>,
 }
 
 impl Reference {
@@ -137,7 +199,9 @@ impl Reference {
                 return Err(EvalError::Input(format!("{}: train and held-out resolutions differ", path.display())));
             }
             let tile = heldout.tile.unwrap_or(DEFAULT_TILE);
-            return Ok(Reference { path: path.to_path_buf(), heldout, train: Some(train), tile });
+            let count = |h: &Heightmap| h.raster.rows / h.tile.unwrap_or(h.raster.rows).max(1);
+            let regions = Regions::load(path, (count(&heldout), count(&train)))?;
+            return Ok(Reference { path: path.to_path_buf(), heldout, train: Some(train), tile, regions });
         }
         if !path.exists() {
             return Err(EvalError::Input(format!(
@@ -147,7 +211,7 @@ impl Reference {
         }
         let heldout = Heightmap::load(path)?;
         let tile = heldout.tile.unwrap_or(DEFAULT_TILE);
-        Ok(Reference { path: path.to_path_buf(), heldout, train: None, tile })
+        Ok(Reference { path: path.to_path_buf(), heldout, train: None, tile, regions: None })
     }
 
     /// Keeps only the first `n` held-out tiles (when there are more): a generated set of
@@ -162,6 +226,9 @@ impl Reference {
         }
         r.rows = n * t;
         r.data.truncate(r.rows * r.cols);
+        if let Some(regions) = &mut self.regions {
+            regions.heldout.truncate(n);
+        }
         true
     }
 

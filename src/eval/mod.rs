@@ -99,7 +99,7 @@ pub fn realism_bar(reference: &[Raster], generated: &[Raster], floor: &[Raster],
         column("fBm", &fbm_like(generated)),
         column("train (real)", floor),
     ];
-    Report::new(Vec::new(), &columns, "").targets
+    Report::new(Vec::new(), &columns, "", None).targets
 }
 
 /// Runs the evaluation: measures generated, fBm, reference and (for a prepared set) training
@@ -150,7 +150,9 @@ pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report
     columns[1].metrics.seams = native_seams(&generated, args.seam_stride);
 
     let notes = notes(args, &reference, &generated, gen_tiles.len(), stride_metres);
-    let table = Report::new(notes, &columns, &format!("lines every {:.0} km", stride_metres / 1000.0));
+    let regions = reference.regions.as_ref().map(|r| r.pooled());
+    let caption = format!("lines every {:.0} km", stride_metres / 1000.0);
+    let table = Report::new(notes, &columns, &caption, regions.as_deref());
     let image = plot::draw(&table.notes, &[report::slope_panel(&columns), report::spectrum_panel(&columns)]);
     save(&image, &args.out)?;
     if let Some(manifest) = &args.record {

@@ -4,6 +4,7 @@ use std::fmt;
 
 use image::Rgb;
 
+use super::input::REGION_SQUARE_TILES;
 use super::measure::SetMetrics;
 use super::plot::{Panel, Series};
 use crate::terrain::metrics::{chi2_distance, histogram, quantile_edges, real_split_distances, wasserstein1};
@@ -43,12 +44,15 @@ pub struct Report {
 }
 
 /// The spectral-slope distance between real sets by the choice of tiles alone
-/// ([`real_split_distances`]): held-out and training tiles pooled and dealt at random into a
-/// set the reference's size and the rest.
+/// ([`real_split_distances`]): held-out and training tiles pooled and dealt at random — by
+/// region when the reference says where its tiles lie — into a set the reference's size and
+/// the rest.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BetaSplits {
     /// Partitions drawn.
     pub splits: usize,
+    /// Whether whole regions were dealt (else single tiles).
+    pub by_region: bool,
     /// Tiles in the first set of each partition (the reference's count) and in the second.
     pub sizes: (usize, usize),
     /// Median |Δβ| over the partitions.
@@ -67,12 +71,15 @@ pub struct BetaSplits {
 }
 
 impl BetaSplits {
-    fn new(reference: &SetMetrics, train: &SetMetrics, line: &Target) -> Option<BetaSplits> {
-        let d = real_split_distances(&reference.spectra, &train.spectra);
+    fn new(reference: &SetMetrics, train: &SetMetrics, line: &Target, regions: Option<&[u64]>) -> Option<BetaSplits> {
+        // Keys only when they name every measured tile (odd-sized leftovers are not measured).
+        let regions = regions.filter(|k| k.len() == reference.spectra.len() + train.spectra.len());
+        let d = real_split_distances(&reference.spectra, &train.spectra, regions);
         let quantile = |q: f64| d[((d.len() - 1) as f64 * q).round() as usize];
         let share = |keep: &dyn Fn(f64) -> bool| d.iter().filter(|&&x| keep(x)).count() as f64 / d.len() as f64;
         (!d.is_empty()).then(|| BetaSplits {
             splits: d.len(),
+            by_region: regions.is_some(),
             sizes: (reference.spectra.len(), train.spectra.len()),
             median: quantile(0.5),
             p90: quantile(0.9),
@@ -170,8 +177,9 @@ fn cell(v: f64, decimals: usize) -> String {
 }
 
 impl Report {
-    /// Builds the table; `columns[0]` is the reference the distances are measured to.
-    pub fn new(notes: Vec<String>, columns: &[Column], seam_caption: &str) -> Report {
+    /// Builds the table; `columns[0]` is the reference the distances are measured to, and
+    /// `regions` (one key per reference then train tile) says which real tiles are neighbours.
+    pub fn new(notes: Vec<String>, columns: &[Column], seam_caption: &str, regions: Option<&[u64]>) -> Report {
         let reference = &columns[0].metrics;
         let slope_edges = quantile_edges(&reference.slopes, STYLE_BINS);
         let relief_edges = quantile_edges(&reference.relief, STYLE_BINS);
@@ -214,8 +222,10 @@ impl Report {
                 let targets = bar([r, g, f, t], &slope_edges, &relief_edges);
                 // Real land judged as if it were generated: the train split against the held-out.
                 let real_land = bar([r, t, f, t], &slope_edges, &relief_edges);
-                let splits =
-                    targets.iter().find(|x| x.key == SPECTRAL_SLOPE_KEY).and_then(|l| BetaSplits::new(r, t, l));
+                let splits = targets
+                    .iter()
+                    .find(|x| x.key == SPECTRAL_SLOPE_KEY)
+                    .and_then(|l| BetaSplits::new(r, t, l, regions));
                 (targets, real_land, splits)
             }
             _ => (Vec::new(), Vec::new(), None),
@@ -280,11 +290,16 @@ impl fmt::Display for Report {
         if let Some(b) = &self.beta_splits {
             writeln!(
                 f,
-                "real vs real by chance: {} random splits of the {} real tiles into {} + {}: |Δβ| median {:.3}, \
+                "real vs real by chance: {} random splits of the {} real tiles ({}) into {} + {}: |Δβ| median {:.3}, \
                  90th percentile {:.3}; within the line {:.3} in {:.0} % of them; farther apart than the \
                  generated terrain's {:.3} in {:.0} %",
                 b.splits,
                 b.sizes.0 + b.sizes.1,
+                if b.by_region {
+                    format!("dealt in whole {0}×{0}-tile squares, as the held-out split is", REGION_SQUARE_TILES)
+                } else {
+                    "dealt tile by tile".into()
+                },
                 b.sizes.0,
                 b.sizes.1,
                 b.median,

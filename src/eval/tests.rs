@@ -217,3 +217,37 @@ fn seams_of_the_generated_map_follow_its_window_lines() {
     let stepped = native_seams(&map, 32).ratio();
     assert!(stepped > smooth * 1.3, "steps on the window lines: {stepped} vs {smooth}");
 }
+
+#[test]
+fn a_prepared_sets_manifest_places_its_tiles_and_the_real_splits_deal_whole_squares() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = prepared_set(dir.path(), 3);
+    // Held-out tiles in square (1, 1), training tiles in squares (0, 0) and (0, 1).
+    let entry = |split: &str, index: usize, row: i64, col: i64| serde_json::json!({"split": split, "index": index, "row": row, "col": col, "lat": 0.0});
+    let tiles = vec![
+        entry("heldout", 0, 2, 2),
+        entry("heldout", 1, 2, 3),
+        entry("heldout", 2, 3, 2),
+        entry("train", 0, 0, 0),
+        entry("train", 1, 1, 1),
+        entry("train", 2, 0, 2),
+    ];
+    std::fs::write(set.join("manifest.json"), serde_json::json!({"stage": "core", "tiles": tiles}).to_string())
+        .unwrap();
+    let reference = Reference::load(&set).unwrap();
+    let regions = reference.regions.as_ref().expect("regions from the manifest");
+    assert!(regions.heldout.iter().all(|k| *k == regions.heldout[0]), "one square: {regions:?}");
+    assert_eq!(regions.train[0], regions.train[1], "tiles (0,0) and (1,1) share a square");
+    assert_ne!(regions.train[0], regions.train[2]);
+    let generated = dir.path().join("gen.npy");
+    write_generated(&generated, 256);
+    let report = run(&args(&generated, &set, &dir.path().join("a.png")), &mut |_, _| {}).unwrap();
+    assert!(report.beta_splits.as_ref().is_some_and(|b| b.by_region), "{report}");
+    assert!(report.to_string().contains("whole 2×2-tile squares"), "{report}");
+
+    // A manifest that misplaces a tile is an input error naming it.
+    let tiles = vec![entry("heldout", 7, 2, 2)];
+    std::fs::write(set.join("manifest.json"), serde_json::json!({"tiles": tiles}).to_string()).unwrap();
+    let err = Reference::load(&set).unwrap_err();
+    assert!(err.to_string().contains("manifest.json") && err.to_string().contains("index 7"), "{err}");
+}

@@ -144,32 +144,61 @@ pub const REAL_SPLITS: usize = 1000;
 
 /// What distance in β two sets of **real** tiles lie apart by the choice of tiles alone: the
 /// tiles of `a` and `b` are pooled and, [`REAL_SPLITS`] times, dealt at random (fixed ChaCha
-/// stream) into a set of `a.len()` tiles and one of the rest; each partition gives
+/// stream) into a set of about `a.len()` tiles and one of the rest; each partition gives
 /// |β(mean of one) − β(mean of the other)|. Returned sorted ascending. A distance line that
-/// most of these miss is one that real land itself misses. Tiles are dealt one by one, so
-/// neighbours' likeness is ignored: a split by regions (as the held-out split is) scatters more. Empty when either set is empty or
-/// the spectra's rings differ.
-pub fn real_split_distances(a: &[Spectrum], b: &[Spectrum]) -> Vec<f64> {
+/// most of these miss is one that real land itself misses.
+///
+/// `regions` (one key per pooled tile, `a`'s first) deals whole regions — neighbouring tiles
+/// alike, as a held-out split by squares is made — until the first set holds `a.len()` tiles
+/// or more; `None` deals tiles one by one, which ignores neighbours' likeness and so scatters
+/// less than a split by regions. Empty when either set is empty, the keys do not match the
+/// tiles, or the spectra's rings differ.
+pub fn real_split_distances(a: &[Spectrum], b: &[Spectrum], regions: Option<&[u64]>) -> Vec<f64> {
     let pool: Vec<&Spectrum> = a.iter().chain(b).collect();
-    if a.is_empty() || b.is_empty() || pool.iter().any(|s| s.frequency != pool[0].frequency) {
+    let bad_keys = regions.is_some_and(|k| k.len() != pool.len());
+    if a.is_empty() || b.is_empty() || bad_keys || pool.iter().any(|s| s.frequency != pool[0].frequency) {
         return Vec::new();
     }
-    let mean_beta = |set: &[&Spectrum]| {
-        let mut power = vec![0.0; set[0].power.len()];
-        for s in set {
-            power.iter_mut().zip(&s.power).for_each(|(p, q)| *p += q / set.len() as f64);
+    // Tiles grouped by region, in order of first appearance (so the deal is reproducible).
+    let mut groups: Vec<Vec<&Spectrum>> = Vec::new();
+    match regions {
+        None => groups.extend(pool.iter().map(|s| vec![*s])),
+        Some(keys) => {
+            let mut index = std::collections::HashMap::new();
+            for (s, k) in pool.iter().zip(keys) {
+                let g = *index.entry(*k).or_insert_with(|| {
+                    groups.push(Vec::new());
+                    groups.len() - 1
+                });
+                groups[g].push(*s);
+            }
         }
-        fit_beta(&Spectrum { frequency: set[0].frequency.clone(), power })
+    }
+    let rings = pool[0].power.len();
+    let mean_beta = |set: &[&Vec<&Spectrum>]| {
+        let mut power = vec![0.0; rings];
+        let mut count = 0;
+        for s in set.iter().flat_map(|g| g.iter()) {
+            power.iter_mut().zip(&s.power).for_each(|(p, q)| *p += q);
+            count += 1;
+        }
+        power.iter_mut().for_each(|p| *p /= count as f64);
+        fit_beta(&Spectrum { frequency: pool[0].frequency.clone(), power })
     };
     let mut rng = ChaCha8Rng::seed_from_u64(0x5711_7000);
-    let mut order: Vec<&Spectrum> = pool.clone();
+    let mut order: Vec<&Vec<&Spectrum>> = groups.iter().collect();
     let mut out: Vec<f64> = (0..REAL_SPLITS)
         .map(|_| {
-            // Fisher–Yates: the first a.len() after the shuffle are one set, the rest the other.
             for i in (1..order.len()).rev() {
                 order.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
             }
-            let (one, other) = order.split_at(a.len());
+            // Whole groups into the first set until it holds a.len() tiles; never all of them.
+            let (mut tiles, mut cut) = (0, 0);
+            while tiles < a.len() && cut < order.len() - 1 {
+                tiles += order[cut].len();
+                cut += 1;
+            }
+            let (one, other) = order.split_at(cut);
             (mean_beta(one) - mean_beta(other)).abs()
         })
         .filter(|d| d.is_finite())
@@ -252,14 +281,28 @@ mod tests {
             power: frequency.iter().map(|f| (f / frequency[8]).powf(beta)).collect(),
         };
         let alike: Vec<Spectrum> = (0..30).map(|_| tile(-2.8)).collect();
-        let same = real_split_distances(&alike[..10], &alike[10..]);
+        let same = real_split_distances(&alike[..10], &alike[10..], None);
         assert_eq!(same.len(), REAL_SPLITS);
         assert!(same.iter().all(|d| *d < 1e-9), "identical tiles never differ: {:?}", same.last());
         let mixed: Vec<Spectrum> = (0..30).map(|i| tile(if i % 3 == 0 { -2.3 } else { -3.1 })).collect();
-        let d = real_split_distances(&mixed[..10], &mixed[10..]);
+        let d = real_split_distances(&mixed[..10], &mixed[10..], None);
         assert!(d.windows(2).all(|w| w[0] <= w[1]), "sorted");
         assert!(d[d.len() / 2] > 0.01 && d[0] < d[d.len() - 1], "median {}", d[d.len() / 2]);
-        assert_eq!(real_split_distances(&mixed[..10], &mixed[10..]), d, "a fixed stream: the same answer every time");
-        assert!(real_split_distances(&mixed[..0], &mixed).is_empty());
+        assert_eq!(
+            real_split_distances(&mixed[..10], &mixed[10..], None),
+            d,
+            "a fixed stream: the same answer every time"
+        );
+        assert!(real_split_distances(&mixed[..0], &mixed, None).is_empty());
+        // Regions of alike tiles (each region one slope): dealt whole, sets differ more often
+        // and by more than when their tiles are dealt one by one.
+        // (Two rugged regions of six, so no deal leaves both sets the same mix.)
+        let regional: Vec<Spectrum> = (0..30).map(|i| tile(if i / 5 < 2 { -2.3 } else { -3.1 })).collect();
+        let keys: Vec<u64> = (0..30).map(|i| i / 5).collect();
+        let by_tile = real_split_distances(&regional[..10], &regional[10..], None);
+        let by_region = real_split_distances(&regional[..10], &regional[10..], Some(&keys));
+        let median = |v: &[f64]| v[v.len() / 2];
+        assert!(median(&by_region) > median(&by_tile), "{} vs {}", median(&by_region), median(&by_tile));
+        assert!(real_split_distances(&regional[..10], &regional[10..], Some(&keys[1..])).is_empty(), "a key per tile");
     }
 }
