@@ -153,7 +153,9 @@ pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report
     let regions = reference.regions.as_ref().map(|r| r.pooled());
     let caption = format!("lines every {:.0} km", stride_metres / 1000.0);
     let table = Report::new(notes, &columns, &caption, regions.as_deref());
-    let image = plot::draw(&table.notes, &[report::slope_panel(&columns), report::spectrum_panel(&columns)]);
+    let mut panels = vec![report::slope_panel(&columns), report::spectrum_panel(&columns)];
+    panels.extend(table.beta_splits.as_ref().map(report::beta_split_panel));
+    let image = plot::draw(&table.notes, &panels);
     save(&image, &args.out)?;
     if let Some(manifest) = &args.record {
         record(manifest, &table)?;

@@ -68,25 +68,37 @@ pub struct BetaSplits {
     /// Fraction of partitions whose |Δβ| is larger than the generated terrain's: real sets
     /// that lie farther apart than the model lies from the reference.
     pub farther_than_generated: f64,
+    /// The training land's |Δβ| to the reference (the real-vs-real floor).
+    pub floor: f64,
+    /// Every partition's |Δβ|, ascending.
+    pub distances: Vec<f64>,
 }
 
 impl BetaSplits {
     fn new(reference: &SetMetrics, train: &SetMetrics, line: &Target, regions: Option<&[u64]>) -> Option<BetaSplits> {
+        let floor = (train.beta - reference.beta).abs();
         // Keys only when they name every measured tile (odd-sized leftovers are not measured).
         let regions = regions.filter(|k| k.len() == reference.spectra.len() + train.spectra.len());
         let d = real_split_distances(&reference.spectra, &train.spectra, regions);
+        if d.is_empty() {
+            return None;
+        }
         let quantile = |q: f64| d[((d.len() - 1) as f64 * q).round() as usize];
         let share = |keep: &dyn Fn(f64) -> bool| d.iter().filter(|&&x| keep(x)).count() as f64 / d.len() as f64;
-        (!d.is_empty()).then(|| BetaSplits {
+        let (median, p90) = (quantile(0.5), quantile(0.9));
+        let (within_line, farther_than_generated) = (share(&|x| x <= line.high), share(&|x| x > line.value));
+        Some(BetaSplits {
             splits: d.len(),
             by_region: regions.is_some(),
             sizes: (reference.spectra.len(), train.spectra.len()),
-            median: quantile(0.5),
-            p90: quantile(0.9),
+            median,
+            p90,
             line: line.high,
-            within_line: share(&|x| x <= line.high),
+            within_line,
             generated: line.value,
-            farther_than_generated: share(&|x| x > line.value),
+            farther_than_generated,
+            floor,
+            distances: d,
         })
     }
 }
@@ -401,6 +413,41 @@ pub fn spectrum_panel(columns: &[Column]) -> Panel {
     }
 }
 
+/// The real-vs-real splits' |Δβ| as a cumulative curve (share of random real splits at most
+/// this far apart), with the realism bar's line, the training land and the generated terrain
+/// marked as vertical lines: where the line falls among real land's own distances.
+pub fn beta_split_panel(b: &BetaSplits) -> Panel {
+    let n = b.distances.len().max(1) as f64;
+    let x_hi = (b.distances.last().copied().unwrap_or(0.1).max(b.generated).max(b.floor) * 10.0).ceil() / 10.0;
+    let curve = b.distances.iter().enumerate().map(|(i, d)| (*d, (i + 1) as f64 / n));
+    let points: Vec<(f64, f64)> = std::iter::once((0.0, 0.0)).chain(curve).collect();
+    let mark = |label: String, colour: [u8; 3], x: f64| Series {
+        label,
+        colour: Rgb(colour),
+        points: vec![(x, 0.0), (x, 1.0)],
+    };
+    let series = vec![
+        Series {
+            label: format!("real vs real, {} random splits", b.distances.len()),
+            colour: Rgb([130, 130, 130]),
+            points,
+        },
+        mark(format!("line {:.3}: {:.0} % of real splits within", b.line, 100.0 * b.within_line), [20, 20, 20], b.line),
+        mark(format!("train vs held-out {:.3}", b.floor), [40, 90, 220], b.floor),
+        mark(format!("generated {:.3}", b.generated), [210, 40, 30], b.generated),
+    ];
+    Panel {
+        title: "spectral slope: real vs real by chance".into(),
+        x_caption: "|Δβ| between the two sets".into(),
+        y_caption: "share of splits at most this far apart".into(),
+        x_range: (0.0, x_hi),
+        y_range: (0.0, 1.0),
+        x_ticks: ticks(0.0, x_hi, nice_step(x_hi / 5.0)),
+        y_ticks: ticks(0.0, 1.0, 0.25),
+        series,
+    }
+}
+
 /// 1, 2 or 5 × 10ⁿ, the first at least `raw`.
 fn nice_step(raw: f64) -> f64 {
     let base = 10f64.powf(raw.max(1e-9).log10().floor());
@@ -408,8 +455,15 @@ fn nice_step(raw: f64) -> f64 {
 }
 
 fn ticks(lo: f64, hi: f64, step: f64) -> Vec<(f64, String)> {
-    let n = ((hi - lo) / step).floor() as usize;
-    (0..=n).map(|k| lo + k as f64 * step).map(|v| (v, format!("{v}"))).collect()
+    let n = ((hi - lo) / step + 1e-9).floor() as usize;
+    // As many decimals as the step has (0.25 → 2), so 3 × 0.05 prints as 0.15.
+    let decimals = (0..6)
+        .find(|&d| {
+            let x = step * 10f64.powi(d);
+            (x - x.round()).abs() < 1e-6
+        })
+        .unwrap_or(6) as usize;
+    (0..=n).map(|k| lo + k as f64 * step).map(|v| (v, format!("{v:.decimals$}"))).collect()
 }
 
 #[cfg(test)]
@@ -422,5 +476,8 @@ mod tests {
         assert_eq!(nice_step(1.5), 2.0);
         assert_eq!(nice_step(0.3), 0.5);
         assert_eq!(ticks(0.0, 10.0, 5.0).len(), 3);
+        let labels: Vec<String> = ticks(0.0, 0.2, 0.05).into_iter().map(|t| t.1).collect();
+        assert_eq!(labels, ["0.00", "0.05", "0.10", "0.15", "0.20"]);
+        assert_eq!(ticks(0.0, 1.0, 0.25)[1].1, "0.25");
     }
 }

@@ -169,6 +169,10 @@ fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
     assert!((0.8..1.25).contains(&seam), "seamless noise has seam ratio ≈ 1, got {seam}");
     let img = image::open(&out).unwrap();
     assert!(img.width() >= 1000 && img.height() >= 400);
+    let panels = 2 + report.beta_splits.is_some() as u32;
+    assert_eq!(panels, 3, "a train split adds the real-vs-real panel");
+    assert_eq!(img.width() % panels, 0, "{} px for {panels} panels", img.width());
+    assert!(img.width() / panels >= 500);
 }
 
 #[test]
