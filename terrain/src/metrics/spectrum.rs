@@ -107,6 +107,20 @@ pub fn fit_beta(s: &Spectrum) -> f64 {
     sxy / sxx
 }
 
+/// [`fit_beta`] of the mean of `spectra` (all of the same rings; NaN when there are none).
+fn beta_of_mean<'a>(spectra: impl IntoIterator<Item = &'a Spectrum>) -> f64 {
+    let mut spectra = spectra.into_iter().peekable();
+    let Some(frequency) = spectra.peek().map(|s| s.frequency.clone()) else { return f64::NAN };
+    let mut power = vec![0.0; frequency.len()];
+    let mut count = 0;
+    for s in spectra {
+        power.iter_mut().zip(&s.power).for_each(|(p, q)| *p += q);
+        count += 1;
+    }
+    power.iter_mut().for_each(|p| *p /= count as f64);
+    fit_beta(&Spectrum { frequency, power })
+}
+
 /// Resamples [`beta_sampling_sd`] draws: enough that the estimate's own scatter is a few per cent.
 pub const BOOTSTRAP_RESAMPLES: usize = 400;
 
@@ -122,16 +136,8 @@ pub fn beta_sampling_sd(spectra: &[Spectrum]) -> f64 {
         return f64::NAN;
     }
     let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_b00f);
-    let rings = spectra[0].power.len();
     let betas: Vec<f64> = (0..BOOTSTRAP_RESAMPLES)
-        .map(|_| {
-            let mut power = vec![0.0; rings];
-            for _ in 0..n {
-                let pick = &spectra[(rng.next_u64() % n as u64) as usize];
-                power.iter_mut().zip(&pick.power).for_each(|(p, q)| *p += q / n as f64);
-            }
-            fit_beta(&Spectrum { frequency: spectra[0].frequency.clone(), power })
-        })
+        .map(|_| beta_of_mean((0..n).map(|_| &spectra[(rng.next_u64() % n as u64) as usize])))
         .filter(|b| b.is_finite())
         .collect();
     let m = betas.len().max(1) as f64;
@@ -174,17 +180,7 @@ pub fn real_split_distances(a: &[Spectrum], b: &[Spectrum], regions: Option<&[u6
             }
         }
     }
-    let rings = pool[0].power.len();
-    let mean_beta = |set: &[&Vec<&Spectrum>]| {
-        let mut power = vec![0.0; rings];
-        let mut count = 0;
-        for s in set.iter().flat_map(|g| g.iter()) {
-            power.iter_mut().zip(&s.power).for_each(|(p, q)| *p += q);
-            count += 1;
-        }
-        power.iter_mut().for_each(|p| *p /= count as f64);
-        fit_beta(&Spectrum { frequency: pool[0].frequency.clone(), power })
-    };
+    let mean_beta = |set: &[&Vec<&Spectrum>]| beta_of_mean(set.iter().flat_map(|g| g.iter().copied()));
     let mut rng = ChaCha8Rng::seed_from_u64(0x5711_7000);
     let mut order: Vec<&Vec<&Spectrum>> = groups.iter().collect();
     let mut out: Vec<f64> = (0..REAL_SPLITS)
@@ -257,14 +253,16 @@ mod tests {
         assert!(Spectrum::mean(&[s.clone(), s.clone()]).is_some_and(|m| m == s));
     }
 
+    /// A tile whose spectrum is the power law k^β, all crossing at ring 9 (so a mix's slope
+    /// depends on how many of each it holds).
+    fn tile(beta: f64) -> Spectrum {
+        let frequency: Vec<f64> = (1..=32).map(|r| r as f64 / 64_000.0).collect();
+        let power = frequency.iter().map(|f| (f / frequency[8]).powf(beta)).collect();
+        Spectrum { frequency, power }
+    }
+
     #[test]
     fn the_bootstrap_sd_grows_with_the_spread_between_tiles() {
-        let frequency: Vec<f64> = (1..=32).map(|r| r as f64 / 64_000.0).collect();
-        // Power laws that cross mid-band, so the mix's slope depends on how many of each it holds.
-        let tile = |beta: f64| Spectrum {
-            frequency: frequency.clone(),
-            power: frequency.iter().map(|f| (f / frequency[8]).powf(beta)).collect(),
-        };
         let alike: Vec<Spectrum> = (0..40).map(|i| tile(-2.8 + 0.001 * (i % 2) as f64)).collect();
         let mixed: Vec<Spectrum> = (0..40).map(|i| tile(if i % 2 == 0 { -2.4 } else { -3.2 })).collect();
         let (a, m) = (beta_sampling_sd(&alike), beta_sampling_sd(&mixed));
@@ -275,11 +273,6 @@ mod tests {
 
     #[test]
     fn real_splits_measure_how_far_real_sets_lie_apart_by_chance() {
-        let frequency: Vec<f64> = (1..=32).map(|r| r as f64 / 64_000.0).collect();
-        let tile = |beta: f64| Spectrum {
-            frequency: frequency.clone(),
-            power: frequency.iter().map(|f| (f / frequency[8]).powf(beta)).collect(),
-        };
         let alike: Vec<Spectrum> = (0..30).map(|_| tile(-2.8)).collect();
         let same = real_split_distances(&alike[..10], &alike[10..], None);
         assert_eq!(same.len(), REAL_SPLITS);
