@@ -99,7 +99,7 @@ pub fn realism_bar(reference: &[Raster], generated: &[Raster], floor: &[Raster],
         column("fBm", &fbm_like(generated)),
         column("train (real)", floor),
     ];
-    Report::new(Vec::new(), &columns, "", None).targets
+    report::targets(&columns)
 }
 
 /// Runs the evaluation: measures generated, fBm, reference and (for a prepared set) training

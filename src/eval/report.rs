@@ -180,6 +180,15 @@ fn bar([reference, generated, fbm, train]: [&SetMetrics; 4], slope_edges: &[f64]
     out
 }
 
+/// Only the realism bar of columns (reference, generated, fBm, train (real)): what a
+/// calibration needs from each trial, without the table, real land's bar or the splits.
+pub fn targets(columns: &[Column]) -> Vec<Target> {
+    let [r, g, f, t] = columns else { return Vec::new() };
+    let slope_edges = quantile_edges(&r.metrics.slopes, STYLE_BINS);
+    let relief_edges = quantile_edges(&r.metrics.relief, STYLE_BINS);
+    bar([&r.metrics, &g.metrics, &f.metrics, &t.metrics], &slope_edges, &relief_edges)
+}
+
 fn cell(v: f64, decimals: usize) -> String {
     if v.is_finite() {
         format!("{v:.decimals$}")

@@ -255,3 +255,25 @@ fn a_prepared_sets_manifest_places_its_tiles_and_the_real_splits_deal_whole_squa
     let err = Reference::load(&set).unwrap_err();
     assert!(err.to_string().contains("manifest.json") && err.to_string().contains("index 7"), "{err}");
 }
+
+#[test]
+fn the_calibrations_realism_bar_is_the_reports_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = prepared_set(dir.path(), 3);
+    let rough = dir.path().join("rough.npy");
+    let data: Vec<f32> = (0..3).flat_map(|i| hills(64, 64, 1000.0, 7 + i).data).map(|v| 3.0 * (v - 800.0)).collect();
+    write_npy_f32(&rough, (3 * 64, 64), &data).unwrap();
+    std::fs::copy(set.join("heldout.json"), rough.with_extension("json")).unwrap();
+    let report = run(&args(&rough, &set, &dir.path().join("a.png")), &mut |_, _| {}).unwrap();
+    let reference = Reference::load(&set).unwrap();
+    let tiles = |h: &Heightmap| h.tiles_at(1000.0, 64);
+    let generated = tiles(&Heightmap::load(&rough).unwrap());
+    let train = tiles(reference.train.as_ref().unwrap());
+    let bar = realism_bar(&tiles(&reference.heldout), &generated, &train, 32);
+    // The report measures the generated map's seams on its own window lines; all else is equal.
+    let without_seams = |t: &[Target]| -> Vec<(String, f64)> {
+        t.iter().filter(|t| t.key != "seam_ratio").map(|t| (t.key.clone(), t.value)).collect()
+    };
+    assert_eq!(without_seams(&bar), without_seams(&report.targets));
+    assert_eq!(bar.len(), report.targets.len());
+}
