@@ -22,13 +22,19 @@ pub struct Spectrum {
 impl Spectrum {
     /// The mean of spectra over the same rings (tiles of one size and resolution); `None`
     /// when there are none or their rings differ.
-    pub fn mean(spectra: &[Spectrum]) -> Option<Spectrum> {
-        let first = spectra.first()?;
-        if spectra.iter().any(|s| s.frequency != first.frequency) {
-            return None;
+    pub fn mean<'a>(spectra: impl IntoIterator<Item = &'a Spectrum>) -> Option<Spectrum> {
+        let mut spectra = spectra.into_iter();
+        let first = spectra.next()?;
+        let (mut power, mut count) = (first.power.clone(), 1);
+        for s in spectra {
+            if s.frequency != first.frequency {
+                return None;
+            }
+            // Ring by ring in the spectra's order: the same sums whoever asks.
+            power.iter_mut().zip(&s.power).for_each(|(p, q)| *p += q);
+            count += 1;
         }
-        let n = spectra.len() as f64;
-        let power = (0..first.power.len()).map(|i| spectra.iter().map(|s| s.power[i]).sum::<f64>() / n).collect();
+        power.iter_mut().for_each(|p| *p /= count as f64);
         Some(Spectrum { frequency: first.frequency.clone(), power })
     }
 }
@@ -107,18 +113,9 @@ pub fn fit_beta(s: &Spectrum) -> f64 {
     sxy / sxx
 }
 
-/// [`fit_beta`] of the mean of `spectra` (all of the same rings; NaN when there are none).
+/// [`fit_beta`] of the mean of `spectra` (NaN when there are none or their rings differ).
 fn beta_of_mean<'a>(spectra: impl IntoIterator<Item = &'a Spectrum>) -> f64 {
-    let mut spectra = spectra.into_iter().peekable();
-    let Some(frequency) = spectra.peek().map(|s| s.frequency.clone()) else { return f64::NAN };
-    let mut power = vec![0.0; frequency.len()];
-    let mut count = 0;
-    for s in spectra {
-        power.iter_mut().zip(&s.power).for_each(|(p, q)| *p += q);
-        count += 1;
-    }
-    power.iter_mut().for_each(|p| *p /= count as f64);
-    fit_beta(&Spectrum { frequency, power })
+    Spectrum::mean(spectra).map_or(f64::NAN, |m| fit_beta(&m))
 }
 
 /// Resamples [`beta_sampling_sd`] draws: enough that the estimate's own scatter is a few per cent.
