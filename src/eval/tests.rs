@@ -65,7 +65,7 @@ fn the_realism_bar_passes_real_terrain_fails_rougher_terrain_and_is_recorded_in_
     let report = run(&a, &mut |_, _| {}).unwrap();
     let slope = report.targets.iter().find(|t| t.key == "slope_w1_deg").expect("slope target");
     assert!(slope.pass && slope.value == 0.0, "{slope:?}");
-    // DESIGN §3's drainage numbers are both on the bar.
+    // docs/realism.md's two drainage numbers are both on the bar.
     for key in ["depressions_per_1000_km2", "fill_volume_per_km2"] {
         let t = report.targets.iter().find(|t| t.key == key).unwrap_or_else(|| panic!("{key} target"));
         assert!(t.pass, "{t:?}");

@@ -1,7 +1,7 @@
 //! Training data for the learned stages: prepared real tiles, encoded once at load, and the
 //! deterministic random crops every step draws from them.
 //!
-//! Encoding follows DESIGN §1: elevations go through the signed square root, then the
+//! Encoding follows docs/learned-terrain.md (encoding): elevations go through the signed square root, then the
 //! Laplacian split (8× downsample + blur) gives the low band the stage is conditioned on; the
 //! network generates the residual. The low band is computed on whole tiles, not on crops, so
 //! a crop sees the same smooth context the pipeline's globally aligned coarse grid gives.

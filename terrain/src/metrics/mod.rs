@@ -1,4 +1,4 @@
-//! Realism metrics (DESIGN §3): how far a heightmap's statistics are from real terrain's.
+//! Realism metrics (defined in docs/realism.md): how far a heightmap's statistics are from real terrain's.
 //!
 //! Owns: the math — slope distributions, style histograms and their distances, radially
 //! averaged power spectra, Priority-Flood depression statistics, seam ratios, and the fBm

@@ -159,7 +159,7 @@ pub struct ModelManifest {
     pub training: TrainingRecord,
     /// What it was trained on.
     pub data: Vec<DataChecksum>,
-    /// Realism numbers (DESIGN §3 metric → value), filled in by evaluation.
+    /// Realism numbers (metric key of docs/realism.md → value), filled in by evaluation.
     pub realism: BTreeMap<String, f64>,
     /// The command that recreates the weights.
     pub recreate: String,
