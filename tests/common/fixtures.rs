@@ -7,11 +7,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-pub use infiniterra::biome::BiomeRules;
-pub use infiniterra::config::Config;
-pub use infiniterra::fill::{BiomePalette, Generator, SkyLight};
-pub use infiniterra::server::find_spawn;
-pub use infiniterra::terrain::Pipeline;
+// Re-exported for the test files; each test crate uses only some (see `common/mod.rs`).
+#[allow(unused_imports)]
+pub use infiniterra::{
+    biome::BiomeRules,
+    config::Config,
+    fill::{BiomePalette, Generator, SkyLight},
+    server::find_spawn,
+    terrain::Pipeline,
+};
 
 use super::repo;
 
