@@ -432,7 +432,12 @@ fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_r
     // A running task also reports its progress every few seconds, unasked ("pregen: 1,351/141,376
     // chunks (1.0%), 568 chunks/s, ETA …"): a command's answer is the next pregen line that is not
     // such a report.
-    let running_report = |l: &str| l.contains(" chunks/s") && !l.contains(", paused") && !l.contains(", finished");
+    let running_report = |l: &str| {
+        l.strip_prefix("pregen: ").is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
+            && l.contains(" chunks/s")
+            && !l.contains(", paused")
+            && !l.contains(", finished")
+    };
     let pregen_line = |l: &str| l.starts_with("pregen") && !running_report(l);
 
     server.command("pregen progress");
