@@ -3,234 +3,18 @@
 //!
 //! Every wait is for a line or an exit, bounded by a timeout; nothing sleeps to synchronise.
 
-use std::io::{BufRead, BufReader, Write};
-use std::net::TcpListener;
-use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, ExitStatus, Stdio};
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
-use std::sync::{Arc, Mutex, OnceLock};
-use std::time::{Duration, Instant};
+mod common;
 
-use infiniterra::biome::BiomeRules;
-use infiniterra::config::Config;
-use infiniterra::fill::Generator;
-use infiniterra::server::find_spawn;
-use infiniterra::terrain::Pipeline;
+use std::path::Path;
+use std::time::Instant;
+
+use common::config::{self, VIEW};
+use common::fixtures::{self, find_spawn, generator, short, BiomeRules, Config, Generator};
+use common::process::{self, Finished};
+use common::server::{Server, LINE_TIMEOUT, START_TIMEOUT};
+use common::{free_port, repo};
 use serde_json::Value;
 use valence::prelude::{BlockState, ChunkPos, ChunkView};
-
-/// Start-up includes building the pipeline and searching a spawn point in a debug build.
-const START_TIMEOUT: Duration = Duration::from_secs(180);
-const LINE_TIMEOUT: Duration = Duration::from_secs(30);
-/// View distance the test players ask for (and the server's cap).
-const VIEW: u8 = 4;
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Installs the node clients once per test binary if `scripts/test` has not already.
-fn node_clients() -> &'static Path {
-    static READY: OnceLock<PathBuf> = OnceLock::new();
-    READY.get_or_init(|| {
-        let dir = repo().join("tests/e2e");
-        if !dir.join("node_modules/mineflayer/package.json").is_file() {
-            let status = Command::new("npm")
-                .args(["ci", "--no-audit", "--no-fund", "--loglevel=error", "--prefix"])
-                .arg(&dir)
-                .status()
-                .expect("npm is needed for the end-to-end tests");
-            assert!(status.success(), "npm ci --prefix tests/e2e failed");
-        }
-        dir
-    })
-}
-
-/// A running server and its console.
-struct Server {
-    child: Child,
-    stdin: Option<ChildStdin>,
-    lines: Receiver<String>,
-    stderr: Arc<Mutex<Vec<String>>>,
-    /// Every stdout line read so far (matched or passed over by [`Server::expect_line`]).
-    history: Vec<String>,
-    port: u16,
-    config: Config,
-    _dir: tempfile::TempDir,
-}
-
-impl Server {
-    /// Starts `infiniterra serve` on a free loopback port with rules from `biomes`, saving to a
-    /// fresh world folder, and waits for "listening on".
-    fn start(biomes: &Path, seed: u64) -> Server {
-        let dir = tempfile::tempdir().expect("temp dir");
-        let world = dir.path().join("world");
-        Server::start_with(biomes, seed, dir, &format!("directory = {:?}\n", world.display().to_string()))
-    }
-
-    /// Starts the server with `world` appended to the `[world]` table of its configuration;
-    /// `dir` holds the configuration and lives as long as the server.
-    fn start_with(biomes: &Path, seed: u64, dir: tempfile::TempDir, world: &str) -> Server {
-        let port = free_port();
-        let config_path = dir.path().join("server.toml");
-        let text = format!(
-            "[server]\nbind = \"127.0.0.1:{port}\"\nview_distance_cap = {VIEW}\nchunk_threads = 2\nchunk_cache = 512\n\n\
-             [world]\nseed = {seed}\n{world}"
-        );
-        std::fs::write(&config_path, text).expect("write config");
-        let config = Config::load(&config_path).expect("test config loads");
-        let mut child = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
-            .arg("serve")
-            .arg("--config")
-            .arg(&config_path)
-            .arg("--biomes")
-            .arg(biomes)
-            .current_dir(repo())
-            .env("RUST_LOG", "info")
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("start infiniterra serve");
-        let (tx, lines) = mpsc::channel();
-        let stdout = child.stdout.take().expect("stdout");
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        let stderr = Arc::new(Mutex::new(Vec::new()));
-        let (sink, err) = (stderr.clone(), child.stderr.take().expect("stderr"));
-        std::thread::spawn(move || {
-            for line in BufReader::new(err).lines().map_while(Result::ok) {
-                sink.lock().unwrap_or_else(|e| e.into_inner()).push(line);
-            }
-        });
-        let stdin = child.stdin.take();
-        let mut server = Server { child, stdin, lines, stderr, history: Vec::new(), port, config, _dir: dir };
-        server.expect_line(|l| l.contains("listening on"), START_TIMEOUT);
-        server
-    }
-
-    /// Waits for a stdout line matching `want`; panics with the server's logs on timeout.
-    fn expect_line(&mut self, want: impl Fn(&str) -> bool, timeout: Duration) -> String {
-        let deadline = Instant::now() + timeout;
-        let mut seen = Vec::new();
-        loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            match self.lines.recv_timeout(left) {
-                Ok(line) if want(&line) => {
-                    self.history.push(line.clone());
-                    return line;
-                }
-                Ok(line) => {
-                    self.history.push(line.clone());
-                    seen.push(line)
-                }
-                Err(RecvTimeoutError::Timeout) => self.fail(&format!("timed out; stdout so far: {seen:#?}")),
-                Err(RecvTimeoutError::Disconnected) => self.fail(&format!("server exited; stdout: {seen:#?}")),
-            }
-        }
-    }
-
-    /// Whether a stdout line read so far matches `want`.
-    fn stdout_seen(&self, want: impl Fn(&str) -> bool) -> bool {
-        self.history.iter().any(|l| want(l))
-    }
-
-    /// Types a console command.
-    fn command(&mut self, command: &str) {
-        let stdin = self.stdin.as_mut().expect("stdin open");
-        writeln!(stdin, "{command}").expect("write to the console");
-        stdin.flush().expect("flush the console");
-    }
-
-    /// `stop`, then waits for the process to exit.
-    fn stop(mut self) -> ExitStatus {
-        self.command("stop");
-        let deadline = Instant::now() + LINE_TIMEOUT;
-        loop {
-            if let Some(status) = self.child.try_wait().expect("wait for the server") {
-                return status;
-            }
-            if Instant::now() > deadline {
-                self.fail("did not exit within 30 s of `stop`");
-            }
-            // Polling an exit status has no event to wait on; this only paces the poll.
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-
-    fn fail(&mut self, why: &str) -> ! {
-        let _ = self.child.kill();
-        let log = self.stderr.lock().unwrap_or_else(|e| e.into_inner()).join("\n");
-        panic!("server: {why}\n--- server stderr ---\n{log}");
-    }
-
-    /// Runs `node tests/e2e/SCRIPT PORT ARGS…` and parses its JSON line.
-    fn node(&mut self, script: &str, args: &[String]) -> Value {
-        let dir = node_clients();
-        let out = Command::new("node").arg(dir.join(script)).arg(self.port.to_string()).args(args).output();
-        let out = out.expect("node is needed for the end-to-end tests");
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let line = stdout.lines().rev().find(|l| l.starts_with('{')).unwrap_or("");
-        match serde_json::from_str::<Value>(line) {
-            Ok(v) => v,
-            Err(_) => self.fail(&format!(
-                "{script} printed no JSON (exit {:?})\nstdout: {stdout}\nstderr: {}",
-                out.status,
-                String::from_utf8_lossy(&out.stderr)
-            )),
-        }
-    }
-
-    /// A player joins and reports; panics unless it spawned.
-    fn probe(&mut self, name: &str, extra: &[String]) -> Value {
-        let mut args = vec!["--name".into(), name.into(), "--view".into(), VIEW.to_string()];
-        args.extend_from_slice(extra);
-        let report = self.node("probe.js", &args);
-        if report["ok"] != Value::Bool(true) {
-            self.fail(&format!("player {name} failed: {report}"));
-        }
-        report
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn free_port() -> u16 {
-    let listener = TcpListener::bind("127.0.0.1:0").expect("bind a free port");
-    listener.local_addr().expect("local address").port()
-}
-
-fn load_rules(dir: &Path) -> BiomeRules {
-    BiomeRules::load_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-}
-
-fn generator(config: &Config) -> Generator {
-    Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), config)
-}
-
-fn short(biome: &str) -> &str {
-    biome.strip_prefix("minecraft:").unwrap_or(biome)
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).expect("create dir");
-    for entry in std::fs::read_dir(from).expect("read biomes") {
-        let path = entry.expect("dir entry").path();
-        if path.is_file() {
-            std::fs::copy(&path, to.join(path.file_name().expect("file name"))).expect("copy");
-        }
-    }
-}
 
 /// Asserts every column the surveyor reported is what `generator` computes with `rules` (top
 /// block, its Y, biome, sky light); returns how many were land.
@@ -279,28 +63,23 @@ fn columns_around(spawn: (i64, i64)) -> (Vec<(i64, i64)>, String) {
 #[test]
 fn the_shipped_learned_core_stage_serves_the_terrain_this_process_computes() {
     // The engine section of the shipped configuration, with the shipped weights.
-    let shipped = Config::load(&repo().join("config/server.toml")).expect("shipped config loads");
+    let shipped = fixtures::shipped_config();
     assert!(shipped.engine.learned.iter().any(|s| s == "core"), "the shipped config runs the learned core");
-    let biomes = repo().join("biomes");
-    let dir = tempfile::tempdir().expect("temp dir");
-    let world = format!(
-        "directory = {:?}\n\n[engine]\nlearned = [\"core\"]\nmodels = {:?}\n",
-        dir.path().join("world").display().to_string(),
-        repo().join("models").display().to_string()
-    );
-    let mut server = Server::start_with(&biomes, 7, dir, &world);
-    let rules = load_rules(&biomes);
+    let biomes = fixtures::shipped_biomes();
+    let keep = tempfile::tempdir().expect("temp dir");
+    let world = config::world_directory(&keep.path().join("world"))
+        + &config::learned_engine(&["core"], &fixtures::shipped_models());
+    let mut server = Server::start_with(&biomes, 7, &world);
+    let rules = fixtures::rules(&biomes);
     assert!(
         server.stdout_seen(|l| l.starts_with("terrain: learned stages core from")),
         "the start-up log says the learned core runs"
     );
     // Built here with one engine thread (the server runs two): the same bits whatever the
     // thread count.
-    let mut terrain = server.config.terrain();
-    terrain.engine.threads = 1;
-    let pipeline = Pipeline::build(server.config.world.seed, &terrain).expect("learned pipeline builds");
+    let pipeline = fixtures::learned_pipeline(&server.config, &["core"], 1);
     assert!(pipeline.active_stages().iter().any(|s| s == "core"), "{:?}", pipeline.active_stages());
-    let generator = Generator::new(Arc::new(pipeline), &server.config);
+    let generator = fixtures::generator_with(pipeline, &server.config);
     let spawn = find_spawn(&generator, &rules);
     let (columns, list) = columns_around((i64::from(spawn.block.x), i64::from(spawn.block.z)));
     let expected_chunks = ChunkView::new(ChunkPos::new(0, 0), VIEW).iter().count();
@@ -315,13 +94,13 @@ fn the_shipped_learned_core_stage_serves_the_terrain_this_process_computes() {
 
 #[test]
 fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
-    let biomes = repo().join("biomes");
+    let biomes = fixtures::shipped_biomes();
     let mut server = Server::start(&biomes, 1);
     assert!(
         server.stdout_seen(|l| l.starts_with("terrain: procedural layout only")),
         "no [engine] learned: procedural"
     );
-    let rules = load_rules(&biomes);
+    let rules = fixtures::rules(&biomes);
     let generator = generator(&server.config);
     let v = *generator.vertical();
     let spawn = find_spawn(&generator, &rules);
@@ -373,7 +152,7 @@ fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
 
 #[test]
 fn garbage_and_wrong_versions_are_refused_and_players_still_join() {
-    let mut server = Server::start(&repo().join("biomes"), 2);
+    let mut server = Server::start(&fixtures::shipped_biomes(), 2);
     let report = server.node("garbage.js", &[]);
     for probe in ["varint_overflow", "http_request", "random_bytes"] {
         assert_eq!(report[probe]["closed"], true, "{probe}: {report}");
@@ -393,12 +172,12 @@ fn garbage_and_wrong_versions_are_refused_and_players_still_join() {
 fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
     let dir = tempfile::tempdir().expect("temp dir");
     let biomes = dir.path().join("biomes");
-    copy_dir(&repo().join("biomes"), &biomes);
+    common::copy_files(&fixtures::shipped_biomes(), &biomes);
     // Saved chunks keep the rules they were made with; with saving off, a revisited place is
     // generated again and so follows the new rules, which is what this test looks at.
-    let mut server = Server::start_with(&biomes, 3, tempfile::tempdir().expect("temp dir"), "save_chunks = false\n");
+    let mut server = Server::start_with(&biomes, 3, "save_chunks = false\n");
     let generator = generator(&server.config);
-    let rules = load_rules(&biomes);
+    let rules = fixtures::rules(&biomes);
     let spawn = find_spawn(&generator, &rules);
     let (x, z) = (i64::from(spawn.block.x), i64::from(spawn.block.z));
     let column = vec!["--columns".to_string(), format!("{x},{z}")];
@@ -435,21 +214,13 @@ fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
 fn start_up_problems_exit_with_a_message_and_the_documented_code() {
     let dir = tempfile::tempdir().expect("temp dir");
     let run_with = |text: &str, biomes: &Path| {
-        let config = dir.path().join("server.toml");
-        std::fs::write(&config, text).expect("write config");
-        let out = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
-            .arg("serve")
-            .arg("--config")
-            .arg(&config)
-            .arg("--biomes")
-            .arg(biomes)
-            .stdin(Stdio::null())
-            .output()
-            .expect("run infiniterra serve");
-        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+        let config = config::write(dir.path(), text);
+        let args = ["serve".as_ref(), "--config".as_ref(), config.as_os_str(), "--biomes".as_ref(), biomes.as_os_str()];
+        let out = Finished::run(process::infiniterra(&repo(), args));
+        (out.code(), out.stderr_text())
     };
     let run = |bind: &str, biomes: &Path| run_with(&format!("[server]\nbind = \"{bind}\"\n"), biomes);
-    let biomes = repo().join("biomes");
+    let biomes = fixtures::shipped_biomes();
 
     let (code, stderr) = run("127.0.0.1:25565", &dir.path().join("no-such-dir"));
     assert_eq!(code, Some(2), "{stderr}");
@@ -459,7 +230,7 @@ fn start_up_problems_exit_with_a_message_and_the_documented_code() {
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("port 0"), "{stderr}");
 
-    let taken = TcpListener::bind("127.0.0.1:0").expect("bind");
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
     let address = taken.local_addr().expect("address").to_string();
     let (code, stderr) = run(&address, &biomes);
     assert_eq!(code, Some(1), "{stderr}");
@@ -481,7 +252,7 @@ fn start_up_problems_exit_with_a_message_and_the_documented_code() {
 
 #[test]
 fn a_flying_player_has_every_chunk_of_its_final_view() {
-    let mut server = Server::start(&repo().join("biomes"), 4);
+    let mut server = Server::start(&fixtures::shipped_biomes(), 4);
     let started = Instant::now();
     // The client asks for more than the server's cap: the view it gets is the cap's.
     let args = ["--name", "flyer", "--view", "6", "--cap", &VIEW.to_string(), "--distance", "500", "--speed", "25"];
@@ -517,31 +288,11 @@ fn a_flying_player_has_every_chunk_of_its_final_view() {
     assert!(server.stop().success());
 }
 
-/// The numbers of the console's `queue:` line: (waiting, in flight, loaded, cached).
-fn queue_numbers(line: &str) -> (u64, u64, u64, u64) {
-    let numbers: Vec<u64> = line
-        .split(|c: char| !c.is_ascii_digit())
-        .filter(|s| !s.is_empty())
-        .map(|s| s.parse().expect("number"))
-        .collect();
-    assert_eq!(numbers.len(), 4, "{line}");
-    (numbers[0], numbers[1], numbers[2], numbers[3])
-}
-
-impl Server {
-    /// `status`, answered with the numbers of its `queue:` line.
-    fn queue(&mut self) -> (u64, u64, u64, u64) {
-        self.command("status");
-        let line = self.expect_line(|l| l.starts_with("queue:"), LINE_TIMEOUT);
-        queue_numbers(&line)
-    }
-}
-
 #[test]
 fn twenty_players_joining_and_leaving_repeatedly_leave_no_chunks_behind() {
     const BOTS: usize = 20;
     const ROUNDS: usize = 3;
-    let mut server = Server::start(&repo().join("biomes"), 5);
+    let mut server = Server::start(&fixtures::shipped_biomes(), 5);
     let (_, _, baseline, _) = server.queue();
     assert_eq!(baseline, 0, "chunks loaded before anyone joined");
 
@@ -577,42 +328,25 @@ fn twenty_players_joining_and_leaving_repeatedly_leave_no_chunks_behind() {
 
     // Still serving: one more player joins, and the process is alive.
     server.probe("after_churn", &[]);
-    assert!(server.child.try_wait().expect("process state").is_none(), "the server exited");
+    assert!(server.process.running(), "the server exited");
     assert!(server.stop().success());
 }
 
-/// A world folder outside the server's own temporary folder, so a second server can reuse it.
-fn world_config(world: &Path) -> String {
-    format!("directory = {:?}\n", world.display().to_string())
-}
-
-/// Runs `infiniterra pregen` (the batch command) around `center`.
+/// Runs `infiniterra pregen` (the batch command) with `config`'s seed around `center`.
 fn batch_pregen(config: &Config, world: &Path, center: (i64, i64), radius: i64) {
     let dir = tempfile::tempdir().expect("temp dir");
-    let config_path = dir.path().join("server.toml");
-    std::fs::write(&config_path, format!("[world]\nseed = {}\n", config.world.seed)).expect("write config");
-    let out = Command::new(env!("CARGO_BIN_EXE_infiniterra"))
-        .arg("pregen")
-        .arg("--config")
-        .arg(&config_path)
-        .arg("--world")
-        .arg(world)
-        .args(["--center", &format!("{},{}", center.0, center.1), "--radius", &radius.to_string()])
-        .arg("--biomes")
-        .arg(repo().join("biomes"))
-        .output()
-        .expect("run infiniterra pregen");
-    assert!(out.status.success(), "pregen: {}", String::from_utf8_lossy(&out.stderr));
+    let config_path = config::write(dir.path(), &config::seed_only(config.world.seed));
+    common::pregen::run_to_end(common::pregen::command(&config_path, world, center, radius));
 }
 
 /// Sets block (`at`, `y`) of saved chunk `chunk` to `block`, as an editor such as Amulet would.
 fn edit_block(world: &Path, generator: &Generator, chunk: (i32, i32), at: (i64, i64), y: i32, block: BlockState) {
-    use infiniterra::fill::{BiomePalette, SkyLight};
+    use fixtures::{BiomePalette, SkyLight};
     use infiniterra::world::codec::{Decoder, Encoder};
     use infiniterra::world::region::{compress, local, RegionFile, RegionPos};
     use valence::prelude::Chunk;
     let v = generator.vertical();
-    let palette = Arc::new(BiomePalette::vanilla());
+    let palette = std::sync::Arc::new(BiomePalette::vanilla());
     let path = world.join("region").join(RegionPos::of_chunk(chunk.0, chunk.1).file_name());
     let mut file = RegionFile::open(&path, false).expect("open region");
     let (lx, lz) = local(chunk.0, chunk.1);
@@ -632,9 +366,8 @@ fn saved_chunks_are_loaded_and_a_corrupt_one_is_reported_and_served_regenerated(
     let seed = 6;
     let keep = tempfile::tempdir().expect("temp dir");
     let world = keep.path().join("world");
-    let mut config = Config::default();
-    config.world.seed = seed;
-    let rules = load_rules(&repo().join("biomes"));
+    let config = fixtures::seeded_config(seed);
+    let rules = fixtures::shipped_rules();
     let generator = generator(&config);
     let spawn = find_spawn(&generator, &rules);
     let (sx, sz) = (i64::from(spawn.block.x), i64::from(spawn.block.z));
@@ -660,8 +393,7 @@ fn saved_chunks_are_loaded_and_a_corrupt_one_is_reported_and_served_regenerated(
     let gold_y = generator.surface(&rules, edited.0, edited.1).y.max(generator.vertical().water_top_y()) + 1;
     edit_block(&world, &generator, (ex, ez), edited, gold_y, BlockState::GOLD_BLOCK);
 
-    let dir = tempfile::tempdir().expect("temp dir");
-    let mut server = Server::start_with(&repo().join("biomes"), seed, dir, &world_config(&world));
+    let mut server = Server::start_with(&fixtures::shipped_biomes(), seed, &config::world_directory(&world));
     let mut columns: Vec<(i64, i64)> = (0..16).map(|i| (cx as i64 * 16 + i, cz as i64 * 16 + 15 - i)).collect();
     columns.push(edited);
     let list = columns.iter().map(|(x, z)| format!("{x},{z}")).collect::<Vec<_>>().join(";");
@@ -695,9 +427,18 @@ fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_r
     let seed = 9;
     let keep = tempfile::tempdir().expect("temp dir");
     let world = keep.path().join("world");
-    let biomes = repo().join("biomes");
-    let mut server = Server::start_with(&biomes, seed, tempfile::tempdir().expect("temp dir"), &world_config(&world));
-    let pregen_line = |l: &str| l.starts_with("pregen");
+    let biomes = fixtures::shipped_biomes();
+    let mut server = Server::start_with(&biomes, seed, &config::world_directory(&world));
+    // A running task also reports its progress every few seconds, unasked ("pregen: 1,351/141,376
+    // chunks (1.0%), 568 chunks/s, ETA …"): a command's answer is the next pregen line that is not
+    // such a report.
+    let running_report = |l: &str| {
+        l.strip_prefix("pregen: ").is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()))
+            && l.contains(" chunks/s")
+            && !l.contains(", paused")
+            && !l.contains(", finished")
+    };
+    let pregen_line = |l: &str| l.starts_with("pregen") && !running_report(l);
 
     server.command("pregen progress");
     assert_eq!(server.expect_line(pregen_line, LINE_TIMEOUT), "pregen: no task");
@@ -753,7 +494,7 @@ fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_r
     let saved = Progress::load(&world.join("pregen.json")).expect("progress").expect("saved at stop");
     assert_eq!(saved.state, State::Running);
     assert!(saved.done > 0, "{saved:?}");
-    let mut server = Server::start_with(&biomes, seed, tempfile::tempdir().expect("temp dir"), &world_config(&world));
+    let mut server = Server::start_with(&biomes, seed, &config::world_directory(&world));
     // (It said "resuming" during start-up; the task is active again, from where it was saved.)
     server.command("pregen progress");
     let line = server.expect_line(|l| l == "pregen: no task" || l.contains(" chunks ("), LINE_TIMEOUT);

@@ -3,32 +3,22 @@
 
 #![cfg(feature = "learned")]
 
-use std::path::PathBuf;
+mod common;
 
-use infiniterra::config::Config;
+use common::fixtures::{self, Pipeline};
 use infiniterra::terrain::model::{burn::tensor::Device, load_model};
 use infiniterra::terrain::pipeline::channel;
 use infiniterra::terrain::tile::Rect;
-use infiniterra::terrain::Pipeline;
 
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The shipped configuration's terrain settings with `learned` stages and `threads`.
+/// The shipped configuration's pipeline with `learned` stages on `threads` engine threads.
 fn pipeline(learned: &[&str], threads: u64) -> Pipeline {
-    let config = Config::load(&repo().join("config/server.toml")).expect("shipped config loads");
-    let mut terrain = config.terrain();
-    terrain.engine.learned = learned.iter().map(|s| s.to_string()).collect();
-    terrain.engine.models = repo().join("models");
-    terrain.engine.threads = threads;
-    Pipeline::build(config.world.seed, &terrain).expect("the shipped models build a pipeline")
+    fixtures::learned_pipeline(&fixtures::shipped_config(), learned, threads)
 }
 
 #[test]
 fn every_shipped_model_loads_and_names_the_command_that_rebuilds_it() {
     for (stage, metres) in [("coarse", 8000.0), ("core", 1000.0), ("detail", 500.0)] {
-        let model = load_model(&repo().join("models"), stage, &Device::flex()).expect("shipped model loads");
+        let model = load_model(&fixtures::shipped_models(), stage, &Device::flex()).expect("shipped model loads");
         let m = &model.manifest;
         assert_eq!((m.stage.as_str(), m.metres_per_pixel), (stage, metres));
         assert!(m.recreate.contains(&format!("train {stage}")), "{stage}: {}", m.recreate);

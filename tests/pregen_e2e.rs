@@ -4,86 +4,38 @@
 //!
 //! Every wait is for a line or an exit; nothing sleeps to synchronise.
 
-use std::collections::BTreeMap;
-use std::io::{BufRead, BufReader, Write};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::sync::Arc;
+mod common;
 
-use infiniterra::biome::BiomeRules;
-use infiniterra::config::Config;
-use infiniterra::fill::{BiomePalette, Generator};
+use std::path::Path;
+use std::process::Command;
+use std::time::Duration;
+
+use common::fixtures::{self, find_spawn, BiomePalette};
+use common::pregen::{region_files, run_to_end, saved_chunks};
+use common::process::{Finished, Process};
+use common::{amulet, config};
 use infiniterra::pregen::{Plan, Progress, Shape, Shard, State, Task};
-use infiniterra::server::find_spawn;
-use infiniterra::terrain::Pipeline;
-use infiniterra::world::region::{RegionFile, RegionPos};
 use serde_json::Value;
-use valence::prelude::{BlockState, Chunk};
+use valence::prelude::Chunk;
 use valence::registry::RegistryIdx;
 
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+/// How long the first checkpoint of a run may take (a debug build computes the terrain).
+const PROGRESS_TIMEOUT: Duration = Duration::from_secs(300);
 
 /// A configuration with `seed`, written into `dir`.
-fn config(dir: &Path, seed: u64) -> PathBuf {
-    let path = dir.join("server.toml");
-    std::fs::write(&path, format!("[world]\nseed = {seed}\n")).expect("write config");
-    path
+fn write_config(dir: &Path, seed: u64) -> std::path::PathBuf {
+    config::write(dir, &config::seed_only(seed))
 }
 
 /// `infiniterra pregen` for the square of `radius` blocks around 0, 0 into `world`.
 fn pregen(config: &Path, world: &Path, radius: i64) -> Command {
-    pregen_at(config, world, (0, 0), radius)
-}
-
-/// `infiniterra pregen` for the square of `radius` blocks around `center` into `world`.
-fn pregen_at(config: &Path, world: &Path, center: (i64, i64), radius: i64) -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_infiniterra"));
-    command
-        .arg("pregen")
-        .args(["--config".as_ref(), config.as_os_str()])
-        .args(["--world".as_ref(), world.as_os_str()])
-        .args(["--center", &format!("{},{}", center.0, center.1)])
-        .args(["--radius", &radius.to_string(), "--threads", "2"])
-        .arg("--biomes")
-        .arg(repo().join("biomes"))
-        .stdin(Stdio::null());
-    command
-}
-
-fn run_to_end(mut command: Command) -> String {
-    let out = command.output().expect("run infiniterra pregen");
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "pregen failed: {:?}\n{stdout}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
-
-/// Every saved chunk of a world: (chunk x, z) → its uncompressed NBT.
-fn saved_chunks(world: &Path) -> BTreeMap<(i32, i32), Vec<u8>> {
-    let mut chunks = BTreeMap::new();
-    for entry in std::fs::read_dir(world.join("region")).expect("region folder") {
-        let path = entry.expect("entry").path();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
-        let region = RegionPos::parse_file_name(&name).unwrap_or_else(|| panic!("stray file {name}"));
-        let mut file = RegionFile::open(&path, false).expect("open region");
-        for (lx, lz) in file.chunks() {
-            let nbt = file.read(lx, lz).expect("readable").expect("present");
-            chunks.insert((region.x * 32 + lx as i32, region.z * 32 + lz as i32), nbt);
-        }
-    }
-    chunks
+    common::pregen::command(config, world, (0, 0), radius)
 }
 
 #[test]
 fn a_killed_pregen_resumes_and_ends_identical_to_an_uninterrupted_one() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let config = config(dir.path(), 7);
+    let config = write_config(dir.path(), 7);
     // ≈ 6,400 chunks: several seconds even in an optimised build, so the kill lands mid-run.
     let radius = 640;
     let task = Task { center_x: 0, center_z: 0, radius, shape: Shape::Square };
@@ -94,19 +46,14 @@ fn a_killed_pregen_resumes_and_ends_identical_to_an_uninterrupted_one() {
     let killed = dir.path().join("killed");
     let mut first = pregen(&config, &killed, radius);
     first.args(["--report-every", "0"]);
-    let mut child = first.stdout(Stdio::piped()).spawn().expect("start pregen");
-    let stdout = BufReader::new(child.stdout.take().expect("stdout"));
-    let mut seen = Vec::new();
-    for line in stdout.lines().map_while(Result::ok) {
-        let progressed = line.starts_with("pregen: ") && line.contains(" chunks (") && !line.starts_with("pregen: 0/");
-        seen.push(line);
-        if progressed {
-            break;
-        }
-    }
-    child.kill().expect("SIGKILL");
-    let status = child.wait().expect("wait");
-    assert!(!status.success(), "it finished before it could be killed: {seen:#?}");
+    let mut child = Process::start(first);
+    child.expect_line(
+        |l| l.starts_with("pregen: ") && l.contains(" chunks (") && !l.starts_with("pregen: 0/"),
+        PROGRESS_TIMEOUT,
+    );
+    let killed_run = child.kill();
+    let seen = &killed_run.stdout;
+    assert!(!killed_run.success(), "it finished before it could be killed: {seen:#?}");
     let saved = Progress::load(&killed.join("pregen.json")).expect("progress file").expect("progress saved");
     assert_eq!(saved.state, State::Running);
     assert!(saved.done > 0 && saved.done < total, "killed at {} of {total}: {seen:#?}", saved.done);
@@ -134,7 +81,7 @@ fn a_killed_pregen_resumes_and_ends_identical_to_an_uninterrupted_one() {
 #[test]
 fn a_progress_file_of_another_task_is_refused_with_its_name() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let config = config(dir.path(), 7);
+    let config = write_config(dir.path(), 7);
     let world = dir.path().join("world");
     run_to_end(pregen(&config, &world, 16));
     // An unfinished task (as a crash leaves it) blocks a different one; a finished one does not.
@@ -142,9 +89,9 @@ fn a_progress_file_of_another_task_is_refused_with_its_name() {
     unfinished.state = State::Running;
     unfinished.done = 0;
     unfinished.save(&world.join("pregen.json")).expect("save");
-    let out = pregen(&config, &world, 48).output().expect("run");
-    assert_eq!(out.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let out = Finished::run(pregen(&config, &world, 48));
+    assert_eq!(out.code(), Some(2));
+    let stderr = out.stderr_text();
     assert!(stderr.contains("pregen.json") && stderr.contains("another task"), "{stderr}");
 
     unfinished.state = State::Finished;
@@ -152,66 +99,29 @@ fn a_progress_file_of_another_task_is_refused_with_its_name() {
     run_to_end(pregen(&config, &world, 48));
 
     // A world made with another seed is refused too: its chunks would not match.
-    let other = self::config(&dir.path().join("x").tap_mkdir(), 8);
-    let out = pregen(&other, &world, 16).output().expect("run");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    let elsewhere = dir.path().join("x");
+    std::fs::create_dir_all(&elsewhere).expect("mkdir");
+    let other = write_config(&elsewhere, 8);
+    let out = Finished::run(pregen(&other, &world, 16));
+    let stderr = out.stderr_text();
+    assert_eq!(out.code(), Some(2), "{stderr}");
     assert!(stderr.contains("seed 7") && stderr.contains("level.dat"), "{stderr}");
-}
-
-trait TapMkdir {
-    fn tap_mkdir(self) -> PathBuf;
-}
-
-impl TapMkdir for PathBuf {
-    fn tap_mkdir(self) -> PathBuf {
-        std::fs::create_dir_all(&self).expect("mkdir");
-        self
-    }
-}
-
-/// The Python with Amulet that `scripts/test` installs (or the same install, done here when
-/// this test runs alone).
-fn amulet_python() -> PathBuf {
-    if let Some(python) = std::env::var_os("INFINITERRA_PYTHON") {
-        return PathBuf::from(python);
-    }
-    let out = Command::new("bash").arg(repo().join("scripts/pyenv")).output().expect("run scripts/pyenv");
-    assert!(out.status.success(), "scripts/pyenv failed: {}", String::from_utf8_lossy(&out.stderr));
-    PathBuf::from(String::from_utf8_lossy(&out.stdout).trim())
-}
-
-/// "minecraft:name[key=value,…]" with properties sorted, as the Amulet script prints blocks.
-fn block_name(state: BlockState) -> String {
-    let kind = state.to_kind();
-    let mut props: Vec<(String, String)> = kind
-        .props()
-        .iter()
-        .filter_map(|&p| state.get(p).map(|v| (p.to_str().to_string(), v.to_str().to_string())))
-        .collect();
-    props.sort();
-    let mut name = format!("minecraft:{}", kind.to_str());
-    if !props.is_empty() {
-        let list: Vec<String> = props.into_iter().map(|(k, v)| format!("{k}={v}")).collect();
-        name.push_str(&format!("[{}]", list.join(",")));
-    }
-    name
 }
 
 #[test]
 fn amulet_reads_the_blocks_and_biomes_we_generate() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let config_path = config(dir.path(), 7);
+    let config_path = write_config(dir.path(), 7);
     let world = dir.path().join("world");
-    let config = Config::load(&config_path).expect("config");
-    let generator = Generator::new(Arc::new(Pipeline::new(7, &config.terrain())), &config);
-    let rules = BiomeRules::load_dir(&repo().join("biomes")).expect("rules");
+    let config = fixtures::Config::load(&config_path).expect("config");
+    let generator = fixtures::generator(&config);
+    let rules = fixtures::shipped_rules();
     let palette = BiomePalette::vanilla();
     let min_y = config.world.min_y as i32;
     // Around the spawn, on land (the origin of this seed is open sea): 8×8 chunks.
     let spawn = find_spawn(&generator, &rules);
     let (sx, sz) = (i64::from(spawn.block.x), i64::from(spawn.block.z));
-    run_to_end(pregen_at(&config_path, &world, (sx, sz), 64));
+    run_to_end(common::pregen::command(&config_path, &world, (sx, sz), 64));
     let plan = Plan::new(Task { center_x: sx, center_z: sz, radius: 64, shape: Shape::Square }, Shard::ALL);
     let chunks: Vec<(i32, i32)> = (0..plan.regions().len()).flat_map(|i| plan.region_chunks(i)).collect();
     assert_eq!(chunks.len(), 64);
@@ -229,7 +139,7 @@ fn amulet_reads_the_blocks_and_biomes_we_generate() {
                 let surface = generator.surface(&rules, x.into(), z.into()).y;
                 for y in [min_y, surface - 5, surface, surface + 1, surface + 2, 300] {
                     let ly = (y - min_y) as u32;
-                    let block = block_name(chunk.block_state(lx, ly, lz));
+                    let block = amulet::block_name(chunk.block_state(lx, ly, lz));
                     let biome = palette.names()[chunk.biome(lx / 4, ly / 4, lz / 4).to_index()].clone();
                     positions.push(serde_json::json!([x, y, z]));
                     expected.push((x, y, z, block, biome));
@@ -238,23 +148,7 @@ fn amulet_reads_the_blocks_and_biomes_we_generate() {
         }
     }
 
-    let mut child = Command::new(amulet_python())
-        .arg(repo().join("tests/anvil/read_world.py"))
-        .arg(&world)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run the Amulet reader");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(Value::Array(positions).to_string().as_bytes())
-        .expect("send positions");
-    let out = child.wait_with_output().expect("Amulet reader");
-    assert!(out.status.success(), "Amulet reader failed: {}", String::from_utf8_lossy(&out.stderr));
-    let report: Value = serde_json::from_slice(&out.stdout).expect("JSON from the Amulet reader");
+    let report = amulet::read_world(&world, positions);
     let read = report["positions"].as_array().expect("positions");
     assert_eq!(read.len(), expected.len());
     let mut kinds = std::collections::HashSet::new();
@@ -277,16 +171,16 @@ fn amulet_reads_the_blocks_and_biomes_we_generate() {
 #[test]
 fn a_full_disk_pauses_the_task_with_the_reason_and_a_rerun_finishes_it() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let config = config(dir.path(), 7);
+    let config = write_config(dir.path(), 7);
     let world = dir.path().join("world");
     // One region file lives on a "disk" that is always full: Linux's /dev/full answers
     // every write with ENOSPC.
     std::fs::create_dir_all(world.join("region")).expect("mkdir");
     let full = world.join("region").join("r.0.0.mca");
     std::os::unix::fs::symlink("/dev/full", &full).expect("symlink");
-    let out = pregen(&config, &world, 48).output().expect("run");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let out = Finished::run(pregen(&config, &world, 48));
+    let stderr = out.stderr_text();
+    assert_eq!(out.code(), Some(1), "{stderr}");
     assert!(stderr.contains("paused") && stderr.contains("r.0.0.mca"), "{stderr}");
     assert!(stderr.contains("No space left on device"), "{stderr}");
     let saved = Progress::load(&world.join("pregen.json")).expect("progress").expect("saved");
@@ -304,7 +198,7 @@ fn a_full_disk_pauses_the_task_with_the_reason_and_a_rerun_finishes_it() {
 #[test]
 fn shards_write_disjoint_region_files_that_together_equal_the_whole_task() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let config = config(dir.path(), 7);
+    let config = write_config(dir.path(), 7);
     let (sharded, whole) = (dir.path().join("sharded"), dir.path().join("whole"));
     let mut files_of = Vec::new();
     for shard in ["0/2", "1/2"] {
@@ -321,12 +215,4 @@ fn shards_write_disjoint_region_files_that_together_equal_the_whole_task() {
     assert!(files_of[0].iter().all(|f| !files_of[1].contains(f)), "shards share a region file");
     run_to_end(pregen(&config, &whole, 300));
     assert!(saved_chunks(&sharded) == saved_chunks(&whole), "the shards' union differs from the whole task");
-}
-
-fn region_files(world: &Path) -> Vec<String> {
-    let Ok(entries) = std::fs::read_dir(world.join("region")) else { return Vec::new() };
-    let mut names: Vec<String> =
-        entries.map(|e| e.expect("entry").file_name().to_string_lossy().into_owned()).collect();
-    names.sort();
-    names
 }
