@@ -130,3 +130,6 @@ impl BiomePalette {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod pinned_tests;

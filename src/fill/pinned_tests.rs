@@ -1,0 +1,137 @@
+//! The world, pinned: every block state and biome of a few regions, hashed into one number
+//! recorded here. A refactor of chunk generation must leave these numbers unchanged; a change
+//! to the world must change them on purpose (and say so in its commit).
+//!
+//! The hash is FNV-1a (64-bit, written out below, not std's randomised hasher) over, in order:
+//! for each region, for each chunk (rows of `z`, then `x`): the chunk coordinates (`i32`
+//! little-endian), then for each column (`z`, then `x`) that is not masked out, every block
+//! state from the floor up ([`BlockState::to_raw`], `u16` little-endian), then every biome
+//! cell (`z`, `x`, then `y`) as its id's index (`u32` little-endian).
+//!
+//! Masked out: the shallow sea, columns whose elevation is in (−60 m, 0 m). Until the sea fix
+//! their ground lay at the water top (Y 62), dry and level with the sea; the fix sinks it one
+//! block under water, so only the hash without them stays the same across that fix.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use valence::prelude::{Chunk, UnloadedChunk};
+use valence::registry::RegistryIdx;
+
+use super::*;
+use crate::biome::BiomeRules;
+use crate::terrain::Rect;
+
+/// FNV-1a, 64-bit.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+}
+
+/// The shipped biome rules (`biomes/`).
+fn shipped_rules() -> BiomeRules {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("biomes");
+    BiomeRules::load_dir(&dir).unwrap_or_else(|e| panic!("the shipped rules must load: {e}"))
+}
+
+/// True for a shallow-sea column (elevation in (−60 m, 0 m)).
+fn shallow(elevation_m: f32) -> bool {
+    elevation_m < 0.0 && elevation_m > -60.0
+}
+
+/// Hashes the `n`×`n` chunks from chunk (`cx0`, `cz0`) into `h` as the module says; returns
+/// how many columns were masked out.
+fn hash_region(
+    g: &Generator,
+    rules: &BiomeRules,
+    palette: &BiomePalette,
+    (cx0, cz0): (i32, i32),
+    n: i32,
+    h: &mut Fnv,
+) -> usize {
+    let (x0, z0) = (i64::from(cx0) * CHUNK, i64::from(cz0) * CHUNK);
+    let size = i64::from(n) * CHUNK;
+    let columns = Columns::query(g.pipeline(), g.vertical(), Rect::new(z0, x0, size, size));
+    let mut count = 0;
+    for cz in cz0..cz0 + n {
+        for cx in cx0..cx0 + n {
+            let chunk = g.chunk(rules, palette, cx, cz);
+            h.bytes(&cx.to_le_bytes());
+            h.bytes(&cz.to_le_bytes());
+            for lz in 0..16u32 {
+                for lx in 0..16u32 {
+                    if shallow(
+                        columns.elevation(i64::from(cx) * CHUNK + i64::from(lx), i64::from(cz) * CHUNK + i64::from(lz)),
+                    ) {
+                        count += 1;
+                        continue;
+                    }
+                    for y in 0..chunk.height() {
+                        h.bytes(&chunk.block_state(lx, y, lz).to_raw().to_le_bytes());
+                    }
+                }
+            }
+            hash_biomes(&chunk, h);
+        }
+    }
+    count
+}
+
+fn hash_biomes(chunk: &UnloadedChunk, h: &mut Fnv) {
+    for z in 0..4 {
+        for x in 0..4 {
+            for y in 0..chunk.height() / 4 {
+                h.bytes(&(chunk.biome(x, y, z).to_index() as u32).to_le_bytes());
+            }
+        }
+    }
+}
+
+/// Regions of the default configuration's world (seed 1, procedural pipeline), as the chunk
+/// of their north-west corner: deep sea, a coast with shallows, and mountains.
+const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -30), (12, 0), (-48, 72)];
+
+/// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] on the default configuration's
+/// world with the shipped biome rules, recorded before chunk generation became passes
+/// (commit "chunk hash recorded before the refactor").
+const PROCEDURAL_HASH: u64 = 0x8823_c654_d25a_d1db;
+/// [`hash_region`] of the 2×2 chunks at chunk (12, 0) with the shipped learned core.
+#[cfg(feature = "learned")]
+const LEARNED_HASH: u64 = 0x39ea_ba96_ef10_fb75;
+
+#[test]
+fn the_procedural_world_is_the_recorded_one_outside_the_shallow_sea() {
+    let config = Config::default();
+    let g = Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), &config);
+    let (rules, palette) = (shipped_rules(), BiomePalette::vanilla());
+    let mut h = Fnv::new();
+    let mut masked = 0;
+    for corner in PROCEDURAL_REGIONS {
+        masked += hash_region(&g, &rules, &palette, corner, 6, &mut h);
+    }
+    assert!(masked > 1000, "only {masked} shallow-sea columns: the coast moved");
+    assert_eq!(h.0, PROCEDURAL_HASH, "the world changed: {:#018x}", h.0);
+}
+
+#[cfg(feature = "learned")]
+#[test]
+fn the_world_of_the_shipped_core_is_the_recorded_one() {
+    let mut config = Config::default();
+    config.engine.learned = vec!["core".to_string()];
+    config.engine.models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let pipeline = Pipeline::build(config.world.seed, &config.terrain()).expect("the shipped core loads");
+    let g = Generator::new(Arc::new(pipeline), &config);
+    let (rules, palette) = (shipped_rules(), BiomePalette::vanilla());
+    let mut h = Fnv::new();
+    hash_region(&g, &rules, &palette, (12, 0), 2, &mut h);
+    assert_eq!(h.0, LEARNED_HASH, "the world changed: {:#018x}", h.0);
+}
