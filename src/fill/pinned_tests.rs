@@ -8,9 +8,16 @@
 //! state from the floor up ([`BlockState::to_raw`], `u16` little-endian), then every biome
 //! cell (`z`, `x`, then `y`) as its id's index (`u32` little-endian).
 //!
-//! Masked out: the shallow sea, columns whose elevation is in (−60 m, 0 m). Until the sea fix
-//! their ground lay at the water top (Y 62), dry and level with the sea; the fix sinks it one
-//! block under water, so only the hash without them stays the same across that fix.
+//! Two numbers pin the procedural world:
+//!
+//! - [`OUTSIDE_SHALLOWS_HASH`], recorded before the sea fix, leaves out the shallow sea
+//!   (columns whose elevation is in (−60 m, 0 m)) and every column within [`SHALLOWS_REACH`]
+//!   blocks of it. Until the fix that ground lay at the water top (Y 62), dry and level with
+//!   the sea; the fix sinks it one block under water, which also uproots the trees that grew
+//!   there, whose crowns reached up to two blocks onto the land next to them. It proves the
+//!   fix changed nothing else.
+//! - [`PROCEDURAL_HASH`], recorded after the sea fix and before chunk generation became passes,
+//!   hashes every column: it proves the passes build the very same world.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -48,19 +55,29 @@ fn shallow(elevation_m: f32) -> bool {
     elevation_m < 0.0 && elevation_m > -60.0
 }
 
-/// Hashes the `n`×`n` chunks from chunk (`cx0`, `cz0`) into `h` as the module says; returns
-/// how many columns were masked out.
+/// How far the sea fix reaches from a shallow-sea column, blocks (Chebyshev): a tree rooted
+/// one block away may lose its root to the new steepness, and crowns reach two blocks further
+/// (less than `trees::REACH`).
+const SHALLOWS_REACH: i64 = 3;
+
+/// Hashes the `n`×`n` chunks from chunk (`cx0`, `cz0`) into `h` as the module says, leaving
+/// out the columns within `mask` blocks of the shallow sea (`None`: leaving out nothing);
+/// returns how many columns were left out.
 fn hash_region(
     g: &Generator,
     rules: &BiomeRules,
     palette: &BiomePalette,
     (cx0, cz0): (i32, i32),
     n: i32,
+    mask: Option<i64>,
     h: &mut Fnv,
 ) -> usize {
     let (x0, z0) = (i64::from(cx0) * CHUNK, i64::from(cz0) * CHUNK);
-    let size = i64::from(n) * CHUNK;
-    let columns = Columns::query(g.pipeline(), g.vertical(), Rect::new(z0, x0, size, size));
+    let (size, m) = (i64::from(n) * CHUNK, mask.unwrap_or(0));
+    let columns = Columns::query(g.pipeline(), g.vertical(), Rect::new(z0 - m, x0 - m, size + 2 * m, size + 2 * m));
+    let masked = |x: i64, z: i64| {
+        mask.is_some() && (-m..=m).any(|dz| (-m..=m).any(|dx| shallow(columns.elevation(x + dx, z + dz))))
+    };
     let mut count = 0;
     for cz in cz0..cz0 + n {
         for cx in cx0..cx0 + n {
@@ -69,9 +86,7 @@ fn hash_region(
             h.bytes(&cz.to_le_bytes());
             for lz in 0..16u32 {
                 for lx in 0..16u32 {
-                    if shallow(
-                        columns.elevation(i64::from(cx) * CHUNK + i64::from(lx), i64::from(cz) * CHUNK + i64::from(lz)),
-                    ) {
+                    if masked(i64::from(cx) * CHUNK + i64::from(lx), i64::from(cz) * CHUNK + i64::from(lz)) {
                         count += 1;
                         continue;
                     }
@@ -100,26 +115,37 @@ fn hash_biomes(chunk: &UnloadedChunk, h: &mut Fnv) {
 /// of their north-west corner: deep sea, a coast with shallows, and mountains.
 const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -30), (12, 0), (-48, 72)];
 
-/// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] on the default configuration's
-/// world with the shipped biome rules, recorded before chunk generation became passes
-/// (commit "chunk hash recorded before the refactor").
-const PROCEDURAL_HASH: u64 = 0x8823_c654_d25a_d1db;
-/// [`hash_region`] of the 2×2 chunks at chunk (12, 0) with the shipped learned core.
+/// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
+/// world with the shipped biome rules) outside the shallow sea, recorded before the sea fix.
+const OUTSIDE_SHALLOWS_HASH: u64 = 0x57ab_0900_032d_e142;
+/// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], recorded after the sea fix.
+const PROCEDURAL_HASH: u64 = 0x51a2_b360_a738_937f;
+/// [`hash_region`] of the 2×2 chunks at chunk (12, 0) with the shipped learned core (no
+/// shallow sea there), recorded before the sea fix.
 #[cfg(feature = "learned")]
 const LEARNED_HASH: u64 = 0x39ea_ba96_ef10_fb75;
 
-#[test]
-fn the_procedural_world_is_the_recorded_one_outside_the_shallow_sea() {
+fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();
     let g = Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), &config);
     let (rules, palette) = (shipped_rules(), BiomePalette::vanilla());
     let mut h = Fnv::new();
-    let mut masked = 0;
-    for corner in PROCEDURAL_REGIONS {
-        masked += hash_region(&g, &rules, &palette, corner, 6, &mut h);
-    }
-    assert!(masked > 1000, "only {masked} shallow-sea columns: the coast moved");
-    assert_eq!(h.0, PROCEDURAL_HASH, "the world changed: {:#018x}", h.0);
+    let masked =
+        PROCEDURAL_REGIONS.iter().map(|&corner| hash_region(&g, &rules, &palette, corner, 6, mask, &mut h)).sum();
+    (h.0, masked)
+}
+
+#[test]
+fn the_procedural_world_is_the_recorded_one_outside_the_shallow_sea() {
+    let (hash, masked) = procedural_hash(Some(SHALLOWS_REACH));
+    assert!(masked > 3000, "only {masked} columns near the shallow sea: the coast moved");
+    assert_eq!(hash, OUTSIDE_SHALLOWS_HASH, "the world changed: {hash:#018x}");
+}
+
+#[test]
+fn the_procedural_world_is_the_recorded_one() {
+    let (hash, _) = procedural_hash(None);
+    assert_eq!(hash, PROCEDURAL_HASH, "the world changed: {hash:#018x}");
 }
 
 #[cfg(feature = "learned")]
@@ -132,6 +158,7 @@ fn the_world_of_the_shipped_core_is_the_recorded_one() {
     let g = Generator::new(Arc::new(pipeline), &config);
     let (rules, palette) = (shipped_rules(), BiomePalette::vanilla());
     let mut h = Fnv::new();
-    hash_region(&g, &rules, &palette, (12, 0), 2, &mut h);
+    let masked = hash_region(&g, &rules, &palette, (12, 0), 2, Some(SHALLOWS_REACH), &mut h);
+    assert_eq!(masked, 0, "the learned region holds shallow sea now");
     assert_eq!(h.0, LEARNED_HASH, "the world changed: {:#018x}", h.0);
 }

@@ -12,7 +12,7 @@ use super::hash::value_noise;
 pub struct Site<'a> {
     /// Biome of the cell holding the surface block (`"minecraft:desert"`).
     pub biome: &'a str,
-    /// Blocks of water above the surface block (0 on land and on shores level with the sea).
+    /// Blocks of water above the surface block (0 on land, at least 1 under the sea).
     pub water_depth: i32,
     /// Blocks the ground falls to its lowest neighbour (see `Columns::drop_blocks`).
     pub drop_blocks: i32,
