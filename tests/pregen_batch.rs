@@ -12,7 +12,7 @@ use std::sync::Arc;
 
 use infiniterra::biome::BiomeRules;
 use infiniterra::config::Config;
-use infiniterra::fill::{BiomePalette, Generator};
+use infiniterra::chunkgen::{BiomePalette, Generator};
 use infiniterra::pregen::{Plan, Progress, Shape, Shard, State, Task};
 use infiniterra::server::find_spawn;
 use infiniterra::terrain::Pipeline;

@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use infiniterra::biome::BiomeRules;
 use infiniterra::config::Config;
-use infiniterra::fill::Generator;
+use infiniterra::chunkgen::Generator;
 use infiniterra::server::find_spawn;
 use infiniterra::terrain::Pipeline;
 use serde_json::Value;
@@ -607,7 +607,7 @@ fn batch_pregen(config: &Config, world: &Path, center: (i64, i64), radius: i64) 
 
 /// Sets block (`at`, `y`) of saved chunk `chunk` to `block`, as an editor such as Amulet would.
 fn edit_block(world: &Path, generator: &Generator, chunk: (i32, i32), at: (i64, i64), y: i32, block: BlockState) {
-    use infiniterra::fill::{BiomePalette, SkyLight};
+    use infiniterra::chunkgen::{BiomePalette, SkyLight};
     use infiniterra::world::codec::{Decoder, Encoder};
     use infiniterra::world::region::{compress, local, RegionFile, RegionPos};
     use valence::prelude::Chunk;
