@@ -1,33 +1,54 @@
-//! Fill: block columns from the terrain pipeline → Minecraft chunks.
+//! Chunk generation: block columns from the terrain pipeline → Minecraft chunks.
 //!
-//! Owns: the vertical mapping (metres → block Y), surface materials, biomes per 4×4×4 cell
-//! and the assembly of a valence [`UnloadedChunk`](valence::prelude::UnloadedChunk). Must not
-//! touch: networking, scheduling or caching (the server's), or how terrain is made (the
+//! Owns: the vertical mapping (metres → block Y), biomes per 4×4×4 cell, the blocks of a
+//! chunk (rock, sea, surface materials, trees and plants) and the sky light of a finished
+//! chunk. Must not touch: networking, scheduling, caching or saving (the server's and the
+//! world's: they call [`Generator::chunk`] and [`SkyLight::of`]), or how terrain is made (the
 //! pipeline's). Everything here is a pure function of (seed, configuration, rules, global
 //! coordinates), so chunks can be built on any thread in any order and still meet seamlessly.
+//!
+//! A chunk is built by an ordered list of passes ([`passes::PASSES`]): columns (the pipeline
+//! query and the biome of every cell) → rock → water → surface → vegetation. Each pass is one
+//! module of `passes/` with one job; it reads the shared [`ChunkContext`] and writes into the
+//! chunk. Sky light is not a pass: the server and the world saver compute it from the
+//! finished blocks ([`SkyLight::of`]).
+//!
+//! Adding a pass (see docs/architecture.md, "Where to add a chunk-generation pass"): write
+//! `passes/<name>.rs` with `pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk)` and
+//! its own unit tests, then add it to [`passes::PASSES`] at its place in the order (the list
+//! marks where carvers and ores go). A pass must stay a pure function of the context and the
+//! chunk so far: anything it decides near a chunk border must be decided the same way by the
+//! neighbouring chunk. The per-column queries ([`Generator::surface`],
+//! [`Generator::plant_blocks`], [`Generator::clear_of_trees`]) share their decisions with the
+//! passes (`column.rs`); a pass that changes the surface or vegetation must keep them in step.
+//! The pinned hashes of `pinned_tests.rs` say whether a change altered the world.
+//!
+//! [`UnloadedChunk`]: valence::prelude::UnloadedChunk
 
 mod cells;
 mod chunk;
+mod column;
 mod columns;
+mod context;
 mod hash;
 mod light;
+mod palette;
+pub mod passes;
 mod plants;
 mod surface;
 mod trees;
 mod vertical;
 
-use std::collections::HashMap;
 use std::sync::Arc;
-
-use valence::prelude::{BiomeId, BiomeRegistry};
-use valence::registry::{RegistryCodec, RegistryIdx};
 
 use crate::config::Config;
 use crate::terrain::Pipeline;
 
-pub use chunk::CHUNK;
+pub use chunk::{PassTiming, CHUNK};
 pub use columns::{Columns, BLOCK_METRES};
+pub use context::ChunkContext;
 pub use light::SkyLight;
+pub use palette::{vanilla_biome_names, BiomePalette};
 pub use plants::is_plant;
 pub use surface::{Ground, Site};
 pub use vertical::Vertical;
@@ -60,6 +81,11 @@ impl Generator {
     pub fn vertical(&self) -> &Vertical {
         &self.vertical
     }
+
+    /// The world seed (of the configuration it was made with).
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
 }
 
 /// What [`Generator::surface`] reports for one column.
@@ -71,61 +97,6 @@ pub struct SurfaceSample {
     pub biome: String,
     /// Name of the ground block there (`"grass_block"`), before any vegetation or sea ice.
     pub top: &'static str,
-}
-
-/// Every biome name Minecraft 1.20.1 knows (`"minecraft:plains"`, …), from the registry
-/// valence sends to clients.
-pub fn vanilla_biome_names() -> Vec<String> {
-    RegistryCodec::default().registry(BiomeRegistry::KEY).iter().map(|v| v.name.as_str().to_string()).collect()
-}
-
-/// Biome names → the ids the client knows them by (its registry order).
-#[derive(Clone, Debug)]
-pub struct BiomePalette {
-    ids: HashMap<String, BiomeId>,
-    /// Name of each id, by index.
-    names: Vec<String>,
-    fallback: BiomeId,
-}
-
-impl BiomePalette {
-    /// Every biome of `registry`; unknown names map to the registry's first biome (plains).
-    pub fn from_registry(registry: &BiomeRegistry) -> BiomePalette {
-        let mut names = vec![String::new(); registry.iter().count()];
-        let mut ids = HashMap::new();
-        for (id, name, _) in registry.iter() {
-            names[id.to_index()] = name.as_str().to_string();
-            ids.insert(name.as_str().to_string(), id);
-        }
-        BiomePalette { ids, names, fallback: BiomeId::DEFAULT }
-    }
-
-    /// The palette of valence's default biome registry without a running server: vanilla's
-    /// biomes in registry order with plains swapped to the front, exactly as valence's biome
-    /// plugin builds the registry the server uses.
-    pub fn vanilla() -> BiomePalette {
-        let mut names = vanilla_biome_names();
-        if let Some(i) = names.iter().position(|n| n == "minecraft:plains") {
-            names.swap(0, i);
-        }
-        let ids = names.iter().enumerate().map(|(i, n)| (n.clone(), BiomeId::from_index(i))).collect();
-        BiomePalette { ids, names, fallback: BiomeId::DEFAULT }
-    }
-
-    /// Biome names indexed by id.
-    pub fn names(&self) -> &[String] {
-        &self.names
-    }
-
-    /// The id of biome `name`, or the fallback when the registry lacks it.
-    pub fn id(&self, name: &str) -> BiomeId {
-        self.ids.get(name).copied().unwrap_or(self.fallback)
-    }
-
-    /// True when the registry holds `name`.
-    pub fn contains(&self, name: &str) -> bool {
-        self.ids.contains_key(name)
-    }
 }
 
 #[cfg(test)]
