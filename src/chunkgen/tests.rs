@@ -393,3 +393,21 @@ fn plains_grow_grass_and_flowers_and_plants_let_the_sky_light_through() {
     }
     assert!(grass > 20 && flowers > 0, "{grass} grass and {flowers} flowers in two plains chunks");
 }
+
+#[test]
+fn timed_chunks_are_the_same_chunks_and_time_every_pass_in_order() {
+    let (g, rules, palette) = (generator(8), rules(), palette());
+    let (timed, timings) = g.chunk_timed(&rules, &palette, -2, 5);
+    let plain = g.chunk(&rules, &palette, -2, 5);
+    let names: Vec<&str> = timings.iter().map(|t| t.name).collect();
+    assert_eq!(names, passes::PASSES.iter().map(|p| p.name).collect::<Vec<_>>());
+    assert_eq!(names, ["columns", "rock", "water", "surface", "vegetation"]);
+    assert!(timings.iter().any(|t| t.nanos > 0));
+    for y in 0..plain.height() {
+        for z in 0..16 {
+            for x in 0..16 {
+                assert_eq!(timed.block_state(x, y, z), plain.block_state(x, y, z));
+            }
+        }
+    }
+}
