@@ -1,7 +1,7 @@
 //! What the ground is made of: the top block and the layer under it, from the biome, the
 //! steepness, the temperature and whether the sea covers it.
 //!
-//! Pure functions of their inputs; the chunk builder stacks the result on stone.
+//! Pure functions of their inputs; the surface pass (`passes/surface.rs`) lays the result on the rock.
 
 use valence::prelude::BlockState;
 
