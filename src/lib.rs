@@ -11,7 +11,7 @@ pub mod cli;
 pub mod config;
 pub mod eval;
 pub mod export;
-pub mod fill;
+pub mod chunkgen;
 pub mod manifest_edit;
 pub mod pregen;
 pub mod render;

@@ -9,7 +9,7 @@ use super::{Failure, Size};
 use crate::biome::BiomeRules;
 use crate::config::Config;
 use crate::export::{self, ExportRequest, Grid, Vertical};
-use crate::fill::Generator;
+use crate::chunkgen::Generator;
 use crate::render::{self, Layer, RenderRequest};
 use crate::terrain::Pipeline;
 

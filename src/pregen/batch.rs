@@ -15,7 +15,7 @@ use super::{run_to_end, Hooks, Job};
 use crate::biome::BiomeRules;
 use crate::cli::Failure;
 use crate::config::Config;
-use crate::fill::{BiomePalette, Generator};
+use crate::chunkgen::{BiomePalette, Generator};
 use crate::server::{check_biome_names, find_spawn};
 use crate::terrain::Pipeline;
 use crate::world::{self, ChunkSource, Store};

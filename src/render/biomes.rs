@@ -8,7 +8,7 @@ use image::{Rgb, RgbImage};
 
 use super::{check, panel, text, title_lines, RenderError, RenderRequest};
 use crate::biome::BiomeRules;
-use crate::fill::Generator;
+use crate::chunkgen::Generator;
 
 /// Map colours of the biomes, close to the ones players know from biome-map tools.
 const COLOURS: &[(&str, [u8; 3])] = &[

@@ -2,8 +2,8 @@
 //!
 //! Owns: the valence app, players joining and their spawn, streaming chunks to their views,
 //! the console, start-up and shutdown. Must not touch: how terrain is made (asks
-//! [`Pipeline`](crate::terrain::Pipeline) through [`fill`](crate::fill)) or how blocks are
-//! chosen (the fill's). Data flows one way: server → fill → pipeline.
+//! [`Pipeline`](crate::terrain::Pipeline) through [`chunkgen`](crate::chunkgen)) or how blocks are
+//! chosen (chunk generation's). Data flows one way: server → chunkgen → pipeline.
 
 /// Prints a line for the owner. A closed stdout (the console piped into a process that has
 /// exited) must not take the server down with a panic, so write errors are ignored.
@@ -30,7 +30,7 @@ use valence::prelude::*;
 
 use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::fill::Generator;
+use crate::chunkgen::Generator;
 use crate::terrain::Pipeline;
 
 pub use spawn::{find_spawn, SpawnPoint};

@@ -3,7 +3,7 @@
 use valence::prelude::*;
 
 use crate::biome::BiomeRules;
-use crate::fill::{Columns, Generator, CHUNK};
+use crate::chunkgen::{Columns, Generator, CHUNK};
 use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, COARSE_FACTOR};
 use crate::terrain::Rect;
 

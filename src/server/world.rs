@@ -8,7 +8,7 @@ use valence::prelude::*;
 
 use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::fill::{vanilla_biome_names, BiomePalette, Generator};
+use crate::chunkgen::{vanilla_biome_names, BiomePalette, Generator};
 use crate::world::Store;
 
 /// What start-up hands the app: configuration, generator and the biome rules.
@@ -63,7 +63,7 @@ fn reshape_dimension(setup: Res<WorldSetup>, mut dimensions: ResMut<DimensionTyp
     dim.height = w.height as i32;
     dim.logical_height = w.height as i32;
     // valence forces full-bright ambient light because it sends no light; the server sends
-    // sky light itself (see `fill::SkyLight`), so the night and the deep sea can be dark.
+    // sky light itself (see `chunkgen::SkyLight`), so the night and the deep sea can be dark.
     dim.ambient_light = 0.0;
 }
 

@@ -9,7 +9,7 @@ use valence::prelude::UnloadedChunk;
 use super::codec::{Decoder, Encoder};
 use super::store::{Store, StoreError};
 use crate::biome::BiomeRules;
-use crate::fill::{BiomePalette, Generator, SkyLight};
+use crate::chunkgen::{BiomePalette, Generator, SkyLight};
 
 /// Where a chunk came from.
 #[derive(Clone, Debug, PartialEq)]

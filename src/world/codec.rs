@@ -13,7 +13,7 @@ use valence::nbt::{Compound, List, Value};
 use valence::prelude::{BiomeId, BlockKind, BlockState, Chunk, PropName, PropValue, UnloadedChunk};
 use valence::registry::RegistryIdx;
 
-use crate::fill::{BiomePalette, SkyLight};
+use crate::chunkgen::{BiomePalette, SkyLight};
 
 /// Minecraft 1.20.1's data version.
 pub const DATA_VERSION: i32 = 3465;

@@ -12,7 +12,7 @@ use valence::registry::RegistryIdx;
 use super::*;
 use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::fill::{BiomePalette, Generator, SkyLight};
+use crate::chunkgen::{BiomePalette, Generator, SkyLight};
 use crate::terrain::Pipeline;
 
 const MIN_Y: i32 = -64;

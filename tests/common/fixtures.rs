@@ -12,7 +12,7 @@ use std::sync::Arc;
 pub use infiniterra::{
     biome::BiomeRules,
     config::Config,
-    fill::{BiomePalette, Generator, SkyLight},
+    chunkgen::{BiomePalette, Generator, SkyLight},
     server::find_spawn,
     terrain::Pipeline,
 };

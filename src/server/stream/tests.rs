@@ -19,7 +19,7 @@ use valence::protocol::PacketEncoder;
 use super::Streamer;
 use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::fill::Generator;
+use crate::chunkgen::Generator;
 use crate::server::world::{self, WorldSetup};
 use crate::terrain::Pipeline;
 

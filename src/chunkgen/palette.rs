@@ -1,77 +1,9 @@
-//! Fill: block columns from the terrain pipeline → Minecraft chunks.
-//!
-//! Owns: the vertical mapping (metres → block Y), surface materials, biomes per 4×4×4 cell
-//! and the assembly of a valence [`UnloadedChunk`](valence::prelude::UnloadedChunk). Must not
-//! touch: networking, scheduling or caching (the server's), or how terrain is made (the
-//! pipeline's). Everything here is a pure function of (seed, configuration, rules, global
-//! coordinates), so chunks can be built on any thread in any order and still meet seamlessly.
-
-mod cells;
-mod chunk;
-mod columns;
-mod hash;
-mod light;
-mod plants;
-mod surface;
-mod trees;
-mod vertical;
+//! Biome names → the ids a client knows them by, in the order of valence's biome registry.
 
 use std::collections::HashMap;
-use std::sync::Arc;
 
 use valence::prelude::{BiomeId, BiomeRegistry};
 use valence::registry::{RegistryCodec, RegistryIdx};
-
-use crate::config::Config;
-use crate::terrain::Pipeline;
-
-pub use chunk::CHUNK;
-pub use columns::{Columns, BLOCK_METRES};
-pub use light::SkyLight;
-pub use plants::is_plant;
-pub use surface::{Ground, Site};
-pub use vertical::Vertical;
-
-/// Builds chunks for one world: the pipeline plus the vertical and climate settings.
-pub struct Generator {
-    pipeline: Arc<Pipeline>,
-    vertical: Vertical,
-    lapse_c_per_km: f32,
-    seed: u64,
-}
-
-impl Generator {
-    /// A generator over `pipeline` with the `[world]` and `[climate]` settings of `config`.
-    pub fn new(pipeline: Arc<Pipeline>, config: &Config) -> Generator {
-        Generator {
-            pipeline,
-            vertical: Vertical::from_world(&config.world),
-            lapse_c_per_km: config.climate.lapse_rate_c_per_km as f32,
-            seed: config.world.seed,
-        }
-    }
-
-    /// The terrain pipeline.
-    pub fn pipeline(&self) -> &Arc<Pipeline> {
-        &self.pipeline
-    }
-
-    /// The vertical mapping.
-    pub fn vertical(&self) -> &Vertical {
-        &self.vertical
-    }
-}
-
-/// What [`Generator::surface`] reports for one column.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SurfaceSample {
-    /// Block Y of the topmost ground block.
-    pub y: i32,
-    /// Biome of the cell holding that block (`"minecraft:plains"`).
-    pub biome: String,
-    /// Name of the ground block there (`"grass_block"`), before any vegetation or sea ice.
-    pub top: &'static str,
-}
 
 /// Every biome name Minecraft 1.20.1 knows (`"minecraft:plains"`, …), from the registry
 /// valence sends to clients.
@@ -127,6 +59,3 @@ impl BiomePalette {
         self.ids.contains_key(name)
     }
 }
-
-#[cfg(test)]
-mod tests;

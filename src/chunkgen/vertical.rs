@@ -37,7 +37,10 @@ impl Vertical {
     /// above sea level:
     ///
     /// - on land (`m ≥ 0`): `sea_level_y + floor(m / metres_per_block)`;
-    /// - under the sea (`m < 0`): `sea_level_y − 1 − floor(−m / sea_metres_per_block)`;
+    /// - under the sea (`m < 0`): `sea_level_y − 1 − floor(−m / sea_metres_per_block)`, but
+    ///   at most `sea_level_y − 2` (one below the water top): every sea column holds water,
+    ///   so the shallowest sea (−60 m < m < 0 with the defaults) is one block deep rather
+    ///   than dry ground level with the sea;
     ///
     /// clamped into `[min_y + 1, min_y + height − 2]` so there is always bedrock below and
     /// one block of air above. A NaN elevation counts as sea level.
@@ -48,7 +51,7 @@ impl Vertical {
         let y = if m >= 0.0 {
             sea.saturating_add((m / self.metres_per_block).floor() as i64)
         } else {
-            (sea - 1).saturating_sub((-m / self.sea_metres_per_block).floor() as i64)
+            (sea - 1).saturating_sub((-m / self.sea_metres_per_block).floor() as i64).min(sea - 2)
         };
         y.clamp(i64::from(self.lowest_surface_y()), i64::from(self.highest_surface_y())) as i32
     }
@@ -93,11 +96,14 @@ mod tests {
     }
 
     #[test]
-    fn the_sea_floor_is_compressed_and_starts_below_the_water_surface() {
+    fn the_sea_floor_is_compressed_and_starts_below_the_water_top() {
         let v = default();
-        assert_eq!(v.surface_y(-0.1), 62);
-        assert_eq!(v.surface_y(-59.9), 62);
+        // The shallowest sea is one block of water, not dry ground at the water top.
+        assert_eq!(v.surface_y(-0.1), 61);
+        assert_eq!(v.surface_y(-59.9), 61);
         assert_eq!(v.surface_y(-60.0), 61);
+        assert_eq!(v.surface_y(-119.9), 61);
+        assert_eq!(v.surface_y(-120.0), 60);
         assert_eq!(v.surface_y(-600.0), 52);
         assert_eq!(v.water_top_y(), 62);
     }

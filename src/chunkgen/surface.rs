@@ -1,7 +1,7 @@
 //! What the ground is made of: the top block and the layer under it, from the biome, the
 //! steepness, the temperature and whether the sea covers it.
 //!
-//! Pure functions of their inputs; the chunk builder stacks the result on stone.
+//! Pure functions of their inputs; the surface pass (`passes/surface.rs`) lays the result on the rock.
 
 use valence::prelude::BlockState;
 
@@ -12,7 +12,7 @@ use super::hash::value_noise;
 pub struct Site<'a> {
     /// Biome of the cell holding the surface block (`"minecraft:desert"`).
     pub biome: &'a str,
-    /// Blocks of water above the surface block (0 on land and on shores level with the sea).
+    /// Blocks of water above the surface block (0 on land, at least 1 under the sea).
     pub water_depth: i32,
     /// Blocks the ground falls to its lowest neighbour (see `Columns::drop_blocks`).
     pub drop_blocks: i32,

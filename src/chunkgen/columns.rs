@@ -1,4 +1,4 @@
-//! Block columns of a rectangle as the fill needs them: the pipeline's elevation and climate
+//! Block columns of a rectangle as chunk generation needs them: the pipeline's elevation and climate
 //! plus what is derived from neighbours (surface Y, slope, steepness).
 //!
 //! Every value depends only on global coordinates (the pipeline is seed-consistent), so two

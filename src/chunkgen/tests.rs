@@ -9,6 +9,8 @@ use valence::prelude::{Biome, BiomeRegistry, BlockState, Chunk, Ident, UnloadedC
 
 use super::*;
 use crate::biome::BiomeRules;
+use crate::terrain::pipeline::channel;
+use crate::terrain::Rect;
 
 const RULES: &str = r#"
 fallback = "minecraft:plains"
@@ -146,25 +148,86 @@ fn biomes_vary_with_height_as_the_air_cools() {
     assert!(distinct.len() >= 2, "one biome from bedrock to sky: {distinct:?}");
 }
 
+/// Checks the column at chunk-local (`lx`, `lz`) of the chunk at (`cx`, `cz`), whose
+/// pipeline values `columns` holds: a sea column (elevation below 0 m) has its ground under
+/// the water top, then water up to the water top, which is ice exactly where the column is
+/// colder than [`surface::SEA_ICE_C`], then air; a land column has dry ground above the sea.
+/// Returns whether the sea column froze (`None` for land).
+fn check_sea_column(
+    chunk: &UnloadedChunk,
+    columns: &Columns,
+    v: &Vertical,
+    (cx, cz): (i32, i32),
+    (lx, lz): (u32, u32),
+) -> Option<bool> {
+    let (x, z) = (i64::from(cx) * 16 + i64::from(lx), i64::from(cz) * 16 + i64::from(lz));
+    let at = |y: i32| chunk.block_state(lx, (y - v.min_y) as u32, lz);
+    let (ground_y, ground) = top(chunk, v, lx, lz);
+    let elevation = columns.elevation(x, z);
+    if elevation >= 0.0 {
+        assert!(ground_y >= v.sea_level_y && !ground.is_liquid(), "land ({x}, {z}) at {elevation} m: {ground:?}");
+        return None;
+    }
+    let floor_y = columns.surface_y(x, z);
+    assert!(floor_y < v.water_top_y(), "sea ({x}, {z}) at {elevation} m has its ground at Y {floor_y}");
+    assert!(!at(floor_y).is_air() && !at(floor_y).is_liquid(), "sea floor ({x}, {z}): {:?}", at(floor_y));
+    for y in floor_y + 1..v.water_top_y() {
+        assert_eq!(at(y), BlockState::WATER, "sea ({x}, {y}, {z}) at {elevation} m");
+    }
+    let frozen = columns.get(channel::TEMPERATURE, x, z) < surface::SEA_ICE_C;
+    let want = if frozen { BlockState::ICE } else { BlockState::WATER };
+    assert_eq!(at(v.water_top_y()), want, "sea surface ({x}, {z}) at {elevation} m");
+    assert_eq!(ground_y, v.water_top_y(), "({x}, {z}): something stands on the sea");
+    assert!(at(v.sea_level_y).is_air(), "({x}, {z}): {:?} above the sea", at(v.sea_level_y));
+    Some(frozen)
+}
+
+/// Checks every column of the `n`×`n` chunks from (`cx0`, `cz0`) with [`check_sea_column`];
+/// returns how many were (land, open sea, frozen sea).
+fn check_sea(g: &Generator, rules: &BiomeRules, (cx0, cz0): (i32, i32), n: i32) -> (usize, usize, usize) {
+    let (v, palette) = (*g.vertical(), palette());
+    let (mut land, mut open, mut frozen) = (0, 0, 0);
+    for cz in cz0..cz0 + n {
+        for cx in cx0..cx0 + n {
+            let chunk = g.chunk(rules, &palette, cx, cz);
+            let rect = Rect::new(i64::from(cz) * 16, i64::from(cx) * 16, 16, 16);
+            let columns = Columns::query(g.pipeline(), &v, rect);
+            for lz in 0..16 {
+                for lx in 0..16 {
+                    match check_sea_column(&chunk, &columns, &v, (cx, cz), (lx, lz)) {
+                        None => land += 1,
+                        Some(false) => open += 1,
+                        Some(true) => frozen += 1,
+                    }
+                }
+            }
+        }
+    }
+    (land, open, frozen)
+}
+
 #[test]
 fn the_sea_is_water_up_to_the_water_top_and_frozen_where_cold() {
-    // Find an ocean chunk near the origin, then check its water column.
-    let (g, rules, palette) = (generator(1), rules(), palette());
+    // A deep-sea chunk of seed 1 that the 0 °C line of the sea surface crosses (found by
+    // bisection along x = 8): some of its columns freeze, the others stay open.
+    let (land, open, frozen) = check_sea(&generator(1), &rules(), (0, -1192), 1);
+    assert_eq!(land, 0);
+    assert!(open > 0 && frozen > 0, "{open} open and {frozen} frozen sea columns: pick a chunk on the 0 °C line");
+}
+
+#[test]
+fn every_sea_column_is_under_water_even_the_shallowest() {
+    // 3×3 chunks of seed 1's coast: shallows, beach and land (before the sea fix, ground at
+    // −60 m .. 0 m lay dry at the water top).
+    let g = generator(1);
     let v = *g.vertical();
-    let sea = (-40..40)
-        .flat_map(|z| (-40..40).map(move |x| (x, z)))
-        .find(|&(x, z)| g.surface(&rules, x * 16 + 8, z * 16 + 8).y < v.water_top_y() - 3);
-    let Some((cx, cz)) = sea else {
-        panic!("no sea within 640 blocks of the origin for seed 1");
-    };
-    let chunk = g.chunk(&rules, &palette, cx as i32, cz as i32);
-    let s = g.surface(&rules, cx * 16 + 8, cz * 16 + 8);
-    for y in s.y + 1..v.water_top_y() {
-        assert_eq!(chunk.block_state(8, (y - v.min_y) as u32, 8), BlockState::WATER, "y {y}");
-    }
-    let surface = chunk.block_state(8, (v.water_top_y() - v.min_y) as u32, 8);
-    assert!(matches!(surface, BlockState::WATER | BlockState::ICE));
-    assert_eq!(chunk.block_state(8, (v.sea_level_y - v.min_y) as u32, 8), BlockState::AIR);
+    let columns = Columns::query(g.pipeline(), &v, Rect::new(2 * 16, 13 * 16, 48, 48));
+    let shallow = (2 * 16..5 * 16)
+        .flat_map(|z| (13 * 16..16 * 16).map(move |x| (x, z)))
+        .filter(|&(x, z)| columns.elevation(x, z) > -60.0 && columns.elevation(x, z) < 0.0)
+        .count();
+    let (land, open, _) = check_sea(&g, &rules(), (13, 2), 3);
+    assert!(land > 100 && open > 100 && shallow > 100, "{land} land, {open} sea, {shallow} shallow columns");
 }
 
 #[test]
@@ -329,4 +392,22 @@ fn plains_grow_grass_and_flowers_and_plants_let_the_sky_light_through() {
         }
     }
     assert!(grass > 20 && flowers > 0, "{grass} grass and {flowers} flowers in two plains chunks");
+}
+
+#[test]
+fn timed_chunks_are_the_same_chunks_and_time_every_pass_in_order() {
+    let (g, rules, palette) = (generator(8), rules(), palette());
+    let (timed, timings) = g.chunk_timed(&rules, &palette, -2, 5);
+    let plain = g.chunk(&rules, &palette, -2, 5);
+    let names: Vec<&str> = timings.iter().map(|t| t.name).collect();
+    assert_eq!(names, passes::PASSES.iter().map(|p| p.name).collect::<Vec<_>>());
+    assert_eq!(names, ["columns", "rock", "water", "surface", "vegetation"]);
+    assert!(timings.iter().any(|t| t.nanos > 0));
+    for y in 0..plain.height() {
+        for z in 0..16 {
+            for x in 0..16 {
+                assert_eq!(timed.block_state(x, y, z), plain.block_state(x, y, z));
+            }
+        }
+    }
 }

@@ -1,0 +1,174 @@
+//! Decisions about one column that the passes and the per-column queries share: its surface
+//! biome, its ground, the trees around it and its plant.
+//!
+//! [`Generator::surface`], [`Generator::plant_blocks`] and [`Generator::clear_of_trees`] answer
+//! for a single column by querying just the rectangle it needs; the passes decide the same
+//! things for a whole chunk with these same functions, so both always agree (tests compare a
+//! live server with the per-column answers).
+
+use valence::prelude::BlockState;
+
+use crate::biome::BiomeRules;
+use crate::terrain::pipeline::channel;
+use crate::terrain::Rect;
+
+use super::cells::{self, CELL};
+use super::columns::Columns;
+use super::plants::{self, Plant};
+use super::surface::{self, Ground, Site};
+use super::trees::{self, Tree};
+use super::{Generator, SurfaceSample};
+
+impl Generator {
+    /// The blocks of the plant on column (`x`, `z`), from the one above the ground upwards
+    /// (empty for bare ground), as [`chunk`](Self::chunk) places them where no tree stands.
+    pub fn plant_blocks(&self, rules: &BiomeRules, x: i64, z: i64) -> Vec<BlockState> {
+        let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
+        let trees = self.trees(rules, &columns, x, z, 1);
+        self.plant_at(rules, &columns, &trees, x, z).map_or_else(Vec::new, |(_, p)| p.blocks())
+    }
+
+    /// The plant of column (`x`, `z`) and the Y of its lowest block, or `None`. `trees` must
+    /// hold every tree rooted within `REACH` of the column and `columns` cover
+    /// [`tree_rect`] of it. Cacti grow only where their four neighbours stay air at every
+    /// height they reach: lower ground, no plant and no tree nearby.
+    pub(super) fn plant_at(
+        &self,
+        rules: &BiomeRules,
+        columns: &Columns,
+        trees: &[Tree],
+        x: i64,
+        z: i64,
+    ) -> Option<(i32, Plant)> {
+        let v = &self.vertical;
+        let candidate = |x: i64, z: i64| -> Option<(i32, Plant)> {
+            let ground_y = columns.surface_y(x, z);
+            if ground_y < v.water_top_y() || columns.drop_blocks(x, z) >= surface::STEEP_DROP_BLOCKS {
+                return None;
+            }
+            let biome = self.surface_biome(rules, columns, x, z);
+            let ground = self.ground_at(columns, biome, x, z);
+            if ground.top.is_liquid() {
+                return None;
+            }
+            plants::candidate(self.seed, biome, ground.top, x, z).map(|p| (ground_y + 1, p))
+        };
+        let (base_y, plant) = candidate(x, z)?;
+        if base_y + plant.blocks().len() as i32 > v.min_y + v.height {
+            return None;
+        }
+        if let Plant::Cactus(_) = plant {
+            let near_tree = trees.iter().any(|t| (t.x - x).abs() <= trees::REACH && (t.z - z).abs() <= trees::REACH);
+            let crowded = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .into_iter()
+                .any(|(dx, dz)| columns.surface_y(x + dx, z + dz) >= base_y || candidate(x + dx, z + dz).is_some());
+            if near_tree || crowded {
+                return None;
+            }
+        }
+        Some((base_y, plant))
+    }
+
+    /// True when no tree stands on or over column (`x`, `z`) (a place to put a player).
+    pub fn clear_of_trees(&self, rules: &BiomeRules, x: i64, z: i64) -> bool {
+        let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
+        self.trees(rules, &columns, x, z, 1)
+            .iter()
+            .all(|t| (t.x - x).abs() >= trees::REACH || (t.z - z).abs() >= trees::REACH)
+    }
+
+    /// Every tree rooted within reach of the `size`×`size` square at (`x0`, `z0`), in global
+    /// order. `columns` must cover [`tree_rect`] of the square.
+    pub(super) fn trees(&self, rules: &BiomeRules, columns: &Columns, x0: i64, z0: i64, size: i64) -> Vec<Tree> {
+        debug_assert!(columns.rect().contains_rect(&tree_rect(x0, z0, size)));
+        let v = &self.vertical;
+        let mut trees = Vec::new();
+        for (x, z, chance) in trees::candidate_roots(self.seed, x0, z0, size) {
+            let biome = self.surface_biome(rules, columns, x, z);
+            let Some((density, kind)) = trees::woodland(biome) else { continue };
+            if chance >= density {
+                continue;
+            }
+            let ground_y = columns.surface_y(x, z);
+            let ground = self.ground_at(columns, biome, x, z);
+            let dry = ground_y >= v.water_top_y() && !ground.top.is_liquid();
+            if dry && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top) {
+                let tree = Tree::new(self.seed, x, z, ground_y, kind);
+                if tree.top_y() < v.min_y + v.height {
+                    trees.push(tree);
+                }
+            }
+        }
+        trees
+    }
+
+    /// Biome of the cell holding the ground block of column (`x`, `z`).
+    pub(super) fn surface_biome<'r>(&self, rules: &'r BiomeRules, columns: &Columns, x: i64, z: i64) -> &'r str {
+        let (sx, sz) = cells::sample_column(x.div_euclid(CELL), z.div_euclid(CELL));
+        let centre = cells::cell_centre_y(columns.surface_y(x, z));
+        rules.biome(&cells::conditions(columns, &self.vertical, self.lapse_c_per_km, sx, sz, centre))
+    }
+
+    /// The topmost ground block of column (`x`, `z`) and the biome of the cell holding it,
+    /// computed exactly as [`chunk`](Self::chunk) computes them (tests compare a live server
+    /// with this).
+    pub fn surface(&self, rules: &BiomeRules, x: i64, z: i64) -> SurfaceSample {
+        let (cell_x, cell_z) = (x.div_euclid(CELL), z.div_euclid(CELL));
+        let columns = Columns::query(
+            &self.pipeline,
+            &self.vertical,
+            Rect::new(cell_z * CELL - 1, cell_x * CELL - 1, CELL + 2, CELL + 2),
+        );
+        let y = columns.surface_y(x, z);
+        let biome = self.surface_biome(rules, &columns, x, z);
+        let top = self.ground_at(&columns, biome, x, z).top;
+        SurfaceSample { y, biome: biome.to_string(), top: top.to_kind().to_str() }
+    }
+
+    /// The ground of column (`x`, `z`) in `biome` (top and filler, by water depth, steepness
+    /// and temperature).
+    pub(super) fn ground_at(&self, columns: &Columns, biome: &str, x: i64, z: i64) -> Ground {
+        let surface_y = columns.surface_y(x, z);
+        surface::ground(&Site {
+            biome,
+            water_depth: (self.vertical.water_top_y() - surface_y).max(0),
+            drop_blocks: columns.drop_blocks(x, z),
+            temperature_c: columns.get(channel::TEMPERATURE, x, z),
+            seed: self.seed,
+            x,
+            z,
+        })
+    }
+}
+
+/// The columns needed to decide the trees around the `size`×`size` square at (`x0`, `z0`)
+/// (and so everything else in it): roots up to `REACH` outside it with one neighbour each
+/// for steepness, and the sample columns (with neighbours) of the biome cells holding them.
+fn tree_rect(x0: i64, z0: i64, size: i64) -> Rect {
+    let span = |lo: i64| {
+        let (first_root, last_root) = (lo - trees::REACH, lo + size - 1 + trees::REACH);
+        let first_sample = cells::sample_column(first_root.div_euclid(CELL), 0).0;
+        let last_sample = cells::sample_column(last_root.div_euclid(CELL), 0).0;
+        let start = (first_root - 1).min(first_sample - 1);
+        (start, (last_root + 1).max(last_sample + 1) - start + 1)
+    };
+    let ((x, w), (z, h)) = (span(x0), span(z0));
+    Rect::new(z, x, h, w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_chunk_needs_four_columns_of_border_and_any_square_its_cells() {
+        assert_eq!(tree_rect(0, 16, 16), Rect::new(12, -4, 24, 24));
+        for x in -9..9 {
+            let r = tree_rect(x, x, 1);
+            // The cell of the farthest root on each side, with its sample column's neighbours.
+            let lo_cell = (x - trees::REACH).div_euclid(CELL) * CELL;
+            assert!(r.x0 <= lo_cell + 1 && r.x0 < x - trees::REACH, "{x}: {r:?}");
+            assert!(r.x1() > x + trees::REACH + 1, "{x}: {r:?}");
+        }
+    }
+}

@@ -1,0 +1,76 @@
+//! What every pass of one chunk shares: where the chunk is, the world's settings and rules,
+//! and what the columns pass learnt (the pipeline's columns, the biome of every cell).
+
+use crate::biome::BiomeRules;
+
+use super::cells::CELL;
+use super::columns::Columns;
+use super::{BiomePalette, Generator, Vertical, CHUNK};
+
+/// The shared state of one chunk's generation, handed to every pass in order.
+pub struct ChunkContext<'a> {
+    /// The generator (pipeline, vertical mapping, climate settings, seed).
+    pub generator: &'a Generator,
+    /// The biome rules.
+    pub rules: &'a BiomeRules,
+    /// Biome names → the ids written into the chunk.
+    pub palette: &'a BiomePalette,
+    /// Global block X of the chunk's first column.
+    pub x0: i64,
+    /// Global block Z of the chunk's first column.
+    pub z0: i64,
+    /// The pipeline's columns over the chunk and a border around it (set by the columns pass).
+    pub columns: Option<Columns>,
+    /// Biome name of every cell, indexed `(cell_z·4 + cell_x)·cells_y + cell_y` (set by the
+    /// columns pass).
+    pub biomes: Vec<&'a str>,
+}
+
+impl<'a> ChunkContext<'a> {
+    /// The context of the chunk at chunk coordinates (`chunk_x`, `chunk_z`), before any pass.
+    pub fn new(
+        generator: &'a Generator,
+        rules: &'a BiomeRules,
+        palette: &'a BiomePalette,
+        chunk_x: i32,
+        chunk_z: i32,
+    ) -> ChunkContext<'a> {
+        ChunkContext {
+            generator,
+            rules,
+            palette,
+            x0: i64::from(chunk_x) * CHUNK,
+            z0: i64::from(chunk_z) * CHUNK,
+            columns: None,
+            biomes: Vec::new(),
+        }
+    }
+
+    /// The vertical mapping.
+    pub fn vertical(&self) -> &Vertical {
+        &self.generator.vertical
+    }
+
+    /// The world seed.
+    pub fn seed(&self) -> u64 {
+        self.generator.seed
+    }
+
+    /// The pipeline's columns; panics before the columns pass has run (passes run in the fixed
+    /// order of [`PASSES`](super::passes::PASSES), columns first).
+    pub fn columns(&self) -> &Columns {
+        self.columns.as_ref().expect("the columns pass runs before any pass that reads columns")
+    }
+
+    /// Biome cells per column of cells (the world's height / 4).
+    pub fn cells_y(&self) -> usize {
+        (self.vertical().height / CELL as i32) as usize
+    }
+
+    /// Every column of the chunk: (chunk-local x, chunk-local z, global x, global z), rows of
+    /// `z`, then `x`.
+    pub fn each_column(&self) -> impl Iterator<Item = (u32, u32, i64, i64)> {
+        let (x0, z0) = (self.x0, self.z0);
+        (0..CHUNK).flat_map(move |lz| (0..CHUNK).map(move |lx| (lx as u32, lz as u32, x0 + lx, z0 + lz)))
+    }
+}

@@ -1,0 +1,86 @@
+//! The passes of chunk generation, in the one order they run (see docs/architecture.md,
+//! "Where to add a chunk-generation pass").
+//!
+//! Each pass has one job, reads the shared [`ChunkContext`] and writes into the chunk; later
+//! passes may overwrite what earlier ones wrote (the surface pass replaces the top of the
+//! rock). Each must be a pure function of global coordinates so that chunks meet without
+//! seams whatever order they are built in.
+
+mod columns;
+mod rock;
+mod surface;
+mod vegetation;
+mod water;
+
+use valence::prelude::UnloadedChunk;
+
+use super::ChunkContext;
+
+/// One pass: a name (for timings) and the function that runs it on a chunk.
+pub struct Pass {
+    /// Short name (`"rock"`), as benchmarks report it.
+    pub name: &'static str,
+    /// Runs the pass: reads and extends the context, writes blocks or biomes into the chunk.
+    pub run: fn(&mut ChunkContext, &mut UnloadedChunk),
+}
+
+/// Every pass, in order.
+pub const PASSES: [Pass; 5] = [
+    // The pipeline's columns around the chunk and the biome of every 4×4×4 cell.
+    Pass { name: "columns", run: columns::run },
+    // Bedrock, then deepslate and stone up to every column's ground.
+    Pass { name: "rock", run: rock::run },
+    // The sea: water from the sea floor to the water top, ice on top where cold.
+    Pass { name: "water", run: water::run },
+    // Carvers (caves, ravines) go here: after the rock and sea exist, before the surface is
+    // laid on what is left. Then ores, into the rock the carvers left.
+    // The ground's top and filler blocks, by biome, steepness and water depth.
+    Pass { name: "surface", run: surface::run },
+    // Trees, then plants where every block they need is still air.
+    Pass { name: "vegetation", run: vegetation::run },
+];
+
+/// Test support: contexts over synthetic columns, for the passes' unit tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    use std::path::PathBuf;
+    use std::sync::Arc;
+
+    use crate::biome::BiomeRules;
+    use crate::chunkgen::{BiomePalette, Columns, Generator};
+    use crate::config::Config;
+    use crate::terrain::pipeline::channel;
+    use crate::terrain::{Pipeline, Rect, Tile};
+
+    /// A generator of the default configuration (its pipeline is not queried by the passes
+    /// that get synthetic columns).
+    pub fn generator() -> Generator {
+        let config = Config::default();
+        Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), &config)
+    }
+
+    /// Rules that give every cell `biome`.
+    pub fn single_biome(biome: &str) -> BiomeRules {
+        let source = format!("fallback = \"{biome}\"\n");
+        BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source)]).expect("single-biome rules")
+    }
+
+    /// Columns over `rect` with elevation (m) and temperature (°C) given per column.
+    pub fn columns(g: &Generator, rect: Rect, f: impl Fn(i64, i64) -> (f32, f32)) -> Columns {
+        let mut tile = Tile::zeros(channel::COUNT, rect);
+        let w = rect.w as usize;
+        for i in 0..rect.area() {
+            let (x, z) = (rect.x0 + (i % w) as i64, rect.y0 + (i / w) as i64);
+            let (elevation, temperature) = f(x, z);
+            tile.channel_mut(channel::ELEVATION)[i] = elevation;
+            tile.channel_mut(channel::TEMPERATURE)[i] = temperature;
+            tile.channel_mut(channel::PRECIPITATION)[i] = 800.0;
+        }
+        Columns::from_tile(tile, g.vertical())
+    }
+
+    /// The vanilla palette.
+    pub fn palette() -> BiomePalette {
+        BiomePalette::vanilla()
+    }
+}
