@@ -5,19 +5,15 @@
 //! benchmarks and (later) the Minecraft server. The terrain itself lives in the
 //! `infiniterra-terrain` crate, which knows nothing of Minecraft.
 
-pub mod bench;
 pub mod biome;
 pub mod cli;
 pub mod config;
-pub mod eval;
 pub mod export;
 pub mod fill;
-pub mod manifest_edit;
+pub mod lab;
 pub mod pregen;
 pub mod render;
 pub mod server;
-#[cfg(feature = "learned")]
-pub mod train;
 pub mod world;
 
 pub use infiniterra_terrain as terrain;

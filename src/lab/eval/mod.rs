@@ -5,9 +5,8 @@
 //! Owns: loading heightmaps and prepared sets, the baselines (fBm matched in amplitude,
 //! real-vs-real), the realism table and the report image. The metric math lives in
 //! `infiniterra_terrain::metrics`. Must not touch: the pipeline (generated terrain comes in
-//! as an exported `.npy`), the command line's parsing beyond [`EvalArgs`] and [`DataArgs`].
+//! as an exported `.npy`), the command line's parsing beyond [`EvalArgs`].
 
-pub mod data;
 mod input;
 mod measure;
 pub(crate) mod plot;
@@ -18,7 +17,6 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use image::Rgb;
 
-pub use data::DataArgs;
 pub use input::{Heightmap, Reference};
 pub use report::{BetaSplits, Report, Target, SPECTRAL_SLOPE_KEY};
 
@@ -187,7 +185,7 @@ fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
         realism.insert("real_split_within_spectral_line".into(), serde_json::json!(b.within_line));
         realism.insert("real_split_farther_than_generated".into(), serde_json::json!(b.farther_than_generated));
     }
-    crate::manifest_edit::edit_manifest(path, |object| {
+    crate::lab::manifest_edit::edit_manifest(path, |object| {
         object.insert("realism".into(), serde_json::Value::Object(realism));
         Ok(())
     })

@@ -134,7 +134,7 @@ pub fn run(
     }
     let shown: Vec<String> = eq.gains.iter().map(|[l, g]| format!("{:.0} km ×{g:.2}", l * metres / 1000.0)).collect();
     println!("spectral equaliser of {}: radius {RADIUS} px, gains {}", path.display(), shown.join(", "));
-    crate::manifest_edit::edit_manifest(&path, |object| {
+    crate::lab::manifest_edit::edit_manifest(&path, |object| {
         object.insert("spectral_equaliser".into(), serde_json::to_value(&eq)?);
         Ok(())
     })

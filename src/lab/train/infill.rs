@@ -19,7 +19,7 @@ use infiniterra_terrain::model::{load_model, ComputeBackend, DepressionInfill};
 
 use super::calibrate::{best, score, BarSets, Trial};
 use super::data::read_split;
-use crate::eval::SPECTRAL_SLOPE_KEY;
+use crate::lab::eval::SPECTRAL_SLOPE_KEY;
 
 /// Depth scales tried after "off", metres, deepest first, halving: from about the depth of
 /// real closed basins 30–60 km across at 1 km (60 m on held-out land, 16–32 km ones 40 m)
@@ -94,7 +94,7 @@ pub fn run(
         chosen.score,
         summary.join("; ")
     );
-    crate::manifest_edit::edit_manifest(&path, |object| {
+    crate::lab::manifest_edit::edit_manifest(&path, |object| {
         match depth {
             Some(c) => {
                 object.insert("depression_infill".into(), serde_json::to_value(DepressionInfill { depth_scale_m: c })?)

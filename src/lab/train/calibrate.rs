@@ -19,7 +19,7 @@ use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel, Relief
 
 use super::data::{read_split, EncodedTile, TileSet};
 use super::heldout::counterpart;
-use crate::eval::{realism_bar, Target};
+use crate::lab::eval::{realism_bar, Target};
 use crate::terrain::metrics::Raster;
 
 /// Offsets tried first (z units): 0, 0.2, … up to [`GRID_MAX`], until two in a row fall
@@ -172,7 +172,7 @@ pub(super) fn load_hinted(models: &Path, stage: &str, data: &Path, backend: Comp
 /// Writes `fields` into the `relief_hint` object of the manifest at `path`, leaving the rest
 /// of the file as it was.
 pub(super) fn write_hint_fields(path: &Path, fields: Vec<(&str, serde_json::Value)>) -> anyhow::Result<()> {
-    crate::manifest_edit::edit_manifest(path, |object| {
+    crate::lab::manifest_edit::edit_manifest(path, |object| {
         let hint = object
             .get_mut("relief_hint")
             .and_then(|h| h.as_object_mut())

@@ -291,7 +291,7 @@ fn fit_relief_hint(models: &Path, stage: &str, data: &Path, features: usize) -> 
         check.rms
     );
     let hint = serde_json::to_value(&hint)?;
-    crate::manifest_edit::edit_manifest(&path, |object| {
+    crate::lab::manifest_edit::edit_manifest(&path, |object| {
         object.insert("relief_hint".into(), hint);
         Ok(())
     })

@@ -7,7 +7,7 @@ use std::path::Path;
 use image::{Rgb, RgbImage};
 
 use super::Measurement;
-use crate::eval::plot::text;
+use crate::lab::eval::plot::text;
 
 /// One bar: a measurement and, when it has one, the goal it is judged against.
 pub struct Bar<'a> {
