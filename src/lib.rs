@@ -8,9 +8,11 @@
 pub mod biome;
 pub mod cli;
 pub mod config;
+pub mod draw;
 pub mod export;
 pub mod fill;
 pub mod lab;
+pub mod npy;
 pub mod pregen;
 pub mod render;
 pub mod server;

@@ -1,351 +1,49 @@
 //! `infiniterra train STAGE`: trains a learned stage on the prepared real data and ships its
 //! weights to `models/<stage>.safetensors` + `models/<stage>.json`.
 //!
-//! Owns: the training loop (EDM loss, Adam, EMA, forced weight normalisation), checkpoints
-//! under `models/checkpoints/<stage>/` that resume exactly after an interruption, progress
-//! lines and preview PNGs. Must not touch: network definitions and sampling (they live in
-//! `infiniterra_terrain::model`, shared with inference), the pipeline.
+//! Owns: the training loop (`trainer`: EDM loss, Adam, EMA, forced weight normalisation,
+//! progress lines and preview PNGs), checkpoints under `models/checkpoints/<stage>/` that
+//! resume exactly after an interruption (`checkpoint`), shipping (`ship`), and the jobs on a
+//! shipped model (`heldout`, `relief_hint` and the calibrations, which load it through
+//! `shipped`). What each stage is comes from the pipeline's stage table (`stage`). Must not
+//! touch: network definitions and sampling (they live in `infiniterra_terrain::model`, shared
+//! with inference), the pipeline, the command line (it converts its arguments into
+//! [`TrainOptions`] and maps [`TrainError`] to exit codes).
 //!
 //! Determinism: every random number (initial weights, crops, flips, σ, noise) is drawn on the
 //! host from ChaCha streams keyed by (seed, step, sample), so a run is a pure function of its
 //! seed and a resumed run continues exactly where the interrupted one left off.
 
 mod calibrate;
+mod checkpoint;
 pub mod data;
 mod ema;
 mod heldout;
 mod infill;
+mod options;
 mod preview;
+mod relief_hint;
 mod response;
+mod ship;
+mod shipped;
 mod spectrum;
+mod stage;
+mod trainer;
 
-use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
 
-use anyhow::{anyhow, bail, Context};
-use burn::module::Module;
-use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
-use burn::tensor::{Device, Tensor, TensorData};
-use infiniterra_terrain::model::{
-    edm_loss, force_normalize, load_model_file, save_model, ComputeBackend, ContextProjection, DataChecksum,
-    ModelManifest, NoiseDistribution, Normalisation, Precision, Sampler, TrainingRecord, UNet, UNetConfig,
-};
-use serde::{Deserialize, Serialize};
+use anyhow::anyhow;
 
-use self::data::{read_split, Batch, TileSet};
-use crate::cli::Failure;
-use infiniterra_terrain::encoding::ContextSpec;
-use infiniterra_terrain::model::burn;
-use infiniterra_terrain::model::hint;
-
-/// Arguments of `infiniterra train`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct TrainArgs {
-    /// Stage to train: `coarse`, `core` or `detail`.
-    pub stage: String,
-    /// Total optimiser steps (a resumed run continues up to this count).
-    #[arg(long, default_value_t = 4000)]
-    pub steps: u64,
-    /// Continue from the stage's checkpoint in `<out>/checkpoints/<stage>/`.
-    #[arg(long)]
-    pub resume: bool,
-    /// Continue training a shipped model (its manifest, e.g. `models/core.json`) when its
-    /// checkpoint is gone: network and EMA start from its weights, and the step count,
-    /// normalisation, batch, crop, seed and schedule from its training record (so the data
-    /// stream and learning rate carry on); only the optimiser's moments start afresh.
-    #[arg(long, conflicts_with = "resume")]
-    pub init_from: Option<PathBuf>,
-    /// Samples per step.
-    #[arg(long, default_value_t = 8)]
-    pub batch: usize,
-    /// Side of the training crops, pixels (a multiple of 8).
-    #[arg(long, default_value_t = 64)]
-    pub crop: usize,
-    /// Reference learning rate (decays as 1/√(step/ref) after `lr_ref_steps`).
-    #[arg(long, default_value_t = 4e-3)]
-    pub lr: f32,
-    /// Steps before the learning rate starts to decay.
-    #[arg(long, default_value_t = 1000)]
-    pub lr_ref_steps: u64,
-    /// EMA decay of the shipped weights.
-    #[arg(long, default_value_t = 0.999)]
-    pub ema: f32,
-    /// Mean of ln σ of the training noise levels (EDM: −1.2). Higher puts more of the
-    /// training at the high noise levels where a few-step sampler's first steps lay out the
-    /// large-scale structure.
-    #[arg(long, default_value_t = -1.2, allow_hyphen_values = true)]
-    pub p_mean: f32,
-    /// Standard deviation of ln σ of the training noise levels (EDM: 1.2).
-    #[arg(long, default_value_t = 1.2)]
-    pub p_std: f32,
-    /// Prepared data folder (holding `core/`, `detail/`, …).
-    #[arg(long, default_value = "data/prepared")]
-    pub data: PathBuf,
-    /// Where the weights, manifests and checkpoints go.
-    #[arg(long, default_value = "models")]
-    pub out: PathBuf,
-    /// Steps between checkpoints.
-    #[arg(long, default_value_t = 100)]
-    pub checkpoint_every: u64,
-    /// Steps between preview PNGs (and validation losses).
-    #[arg(long, default_value_t = 250)]
-    pub preview_every: u64,
-    /// Steps between progress lines.
-    #[arg(long, default_value_t = 10)]
-    pub log_every: u64,
-    /// Stop cleanly (checkpoint + ship) after this many minutes of wall time.
-    #[arg(long)]
-    pub minutes: Option<f64>,
-    /// Storage precision of the shipped weights.
-    #[arg(long, default_value = "f16", value_parser = parse_precision)]
-    pub precision: Precision,
-    /// Compute backend: `cpu` (burn flex) or `wgpu` (needs the `wgpu` build feature).
-    #[arg(long, default_value = "cpu", value_parser = parse_backend)]
-    pub backend: ComputeBackend,
-    /// Instead of training: write this many held-out tiles generated by the shipped model
-    /// to `--generate-heldout FILE.npy` (for `infiniterra eval`).
-    #[arg(long, default_value_t = 16)]
-    pub tiles: usize,
-    /// Instead of training, generate held-out counterparts into this `.npy` (see `--tiles`).
-    #[arg(long)]
-    pub generate_heldout: Option<PathBuf>,
-    /// With `--generate-heldout`: counterparts of each tile, each drawn with its own noise
-    /// (the realism bar of a stochastic model is measured on several draws, not one).
-    #[arg(long, default_value_t = 1)]
-    pub draws: usize,
-    /// Instead of training: generate the counterpart of this real square region (`.npy` at the
-    /// model's resolution, e.g. from `scripts/data/region.py`) and draw both side by side to
-    /// `--picture`.
-    #[arg(long)]
-    pub counterpart: Option<PathBuf>,
-    /// Picture written by `--counterpart`.
-    #[arg(long, default_value = "docs/core_vs_real.png")]
-    pub picture: PathBuf,
-    /// Instead of training: fit the relief hint (context → expected roughness) of the shipped
-    /// `<out>/<stage>.json` on the stage's training data and write it into that manifest.
-    #[arg(long)]
-    pub fit_relief_hint: bool,
-    /// Fit the relief hint (when training ships, or with `--fit-relief-hint`) on the four
-    /// statistics of the window's 8 km blocks too (held-out R² 0.93 instead of 0.88; the
-    /// shipped core's hint is fitted without them).
-    #[arg(long)]
-    pub hint_block_statistics: bool,
-    /// Instead of training: choose the relief hint's offset of the shipped `<out>/<stage>.json`
-    /// by generating `--tiles` training tiles for a grid of offsets and scoring each set with
-    /// the realism bar (minutes), and write it into that manifest.
-    #[arg(long)]
-    pub calibrate_relief_hint: bool,
-    /// Instead of training: measure how much relief the shipped `<out>/<stage>.json` draws
-    /// when its hint is raised by 0, 1 and 2 on `--tiles` training tiles, and write the
-    /// inverted response (extra relief to ask for, by expected relief) into that manifest.
-    #[arg(long)]
-    pub calibrate_relief_response: bool,
-    /// Instead of training: compare the spectra of `--tiles` training tiles and of the shipped
-    /// `<out>/<stage>.json`'s counterparts of them, and write the spectral equaliser (gain per
-    /// wavelength) that brings the second to the first into that manifest. Run it after
-    /// `--calibrate-relief-response`.
-    #[arg(long)]
-    pub calibrate_spectrum: bool,
-    /// Instead of training: generate `--tiles` training tiles with the shipped
-    /// `<out>/<stage>.json`'s depression infill off and at depth scales from 160 m down, score
-    /// each set with the realism bar, and write the best into that manifest. Run it after
-    /// `--calibrate-spectrum`.
-    #[arg(long)]
-    pub calibrate_infill: bool,
-    /// Train the stage's network at half the width (≈ ¼ of its cost per pixel). Trained
-    /// briefly into its own `--out`, it is the shipped model's autoguidance guide: a "bad
-    /// version of itself" whose errors guidance steers away from (`guide` in the manifest).
-    #[arg(long)]
-    pub half_width: bool,
-    /// Use a very small network and no data files (smoke tests of the training machinery).
-    #[arg(long, hide = true)]
-    pub smoke: bool,
-}
-
-impl TrainArgs {
-    /// How many of [`hint::FEATURE_NAMES`] a new relief-hint fit uses.
-    fn hint_features(&self) -> usize {
-        if self.hint_block_statistics {
-            hint::FEATURES
-        } else {
-            hint::BASE_FEATURES
-        }
-    }
-}
-
-fn parse_precision(s: &str) -> Result<Precision, String> {
-    match s {
-        "f16" => Ok(Precision::F16),
-        "f32" => Ok(Precision::F32),
-        _ => Err(format!("unknown precision `{s}` (expected f16 or f32)")),
-    }
-}
-
-fn parse_backend(s: &str) -> Result<ComputeBackend, String> {
-    s.parse().map_err(|e: infiniterra_terrain::model::BackendError| e.to_string())
-}
-
-/// Back-projection passes of the core's windows onto their context cells.
-const PROJECTION_PASSES: usize = 4;
+pub use self::options::{TrainError, TrainOptions};
+use self::stage::{stage_data, stage_spec};
+use self::trainer::Trainer;
 
 /// The training seed when `--seed` is not given.
 pub const DEFAULT_SEED: u64 = 0;
 
-/// What a stage trains on and at what resolution.
-struct StageSpec {
-    metres_per_pixel: f64,
-    config: UNetConfig,
-    sampler: Sampler,
-    /// How its context is made from the grid above it.
-    context: ContextSpec,
-    /// Window stride at inference (0: half the window).
-    stride: usize,
-    /// Back-projection of each window onto its context cells (unblurred contexts only).
-    projection: Option<ContextProjection>,
-}
-
-fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, Failure> {
-    let pick = |full: UNetConfig| if smoke { UNetConfig::tiny() } else { full };
-    match stage {
-        // 1 km relief over 8 km box means, unblurred: the blurred means of the paper's
-        // Laplacian split take the 16–64 km band out of the context, and a 64-pixel window
-        // cannot put it back (the first cores drew a third of its power, with or without
-        // window overlap); unblurred, the context carries it and the model draws what is
-        // finer than 8 km.
-        "core" => Ok(StageSpec {
-            metres_per_pixel: 1000.0,
-            config: pick(UNetConfig::core()),
-            sampler: Sampler::few_step(),
-            context: ContextSpec { factor: 8, blur: false },
-            stride: 0,
-            // Its windows missed their context cells by 23 m on held-out land, and part of the
-            // 16–45 km band with them (see `model::projection`).
-            projection: Some(ContextProjection { iterations: PROJECTION_PASSES }),
-        }),
-        // The same network one level up: 8 km relief (continents, shelves, basins) refining
-        // the layout's sketch from its blurred 16 km means. (The first coarse weights used
-        // 64 km means, as the core does one level down, and flattened the layout's narrower
-        // ranges: a 3,000 m range came out as 1,000 m blobs.)
-        "coarse" => Ok(StageSpec {
-            metres_per_pixel: 8000.0,
-            config: pick(UNetConfig::core()),
-            sampler: Sampler::few_step(),
-            context: ContextSpec { factor: 2, blur: true },
-            stride: 0,
-            projection: None,
-        }),
-        // The last stage: 500 m relief over the core's own 1 km grid, unblurred (the core's
-        // relief is kept; only what is finer than 1 km is generated), with the paper's 75 %
-        // window overlap for the decoder.
-        "detail" => Ok(StageSpec {
-            metres_per_pixel: 500.0,
-            config: pick(UNetConfig::detail()),
-            sampler: Sampler::few_step(),
-            context: ContextSpec { factor: 2, blur: false },
-            stride: 16,
-            projection: None,
-        }),
-        _ => Err(Failure::input(anyhow!("unknown stage `{stage}` (stages: coarse, core, detail)"))),
-    }
-}
-
-/// Loads a stage's prepared set (`<dir>/<stage>/`), train and held-out, encoded with the
-/// stage's context: ETOPO5 8 km tiles for coarse, GLOBE 1 km tiles for core, GEBCO 500 m
-/// tiles (Kyrgyzstan) for detail. The 500 m tiles are not added to the core's (downsampled):
-/// they lie inside the core set's held-out band (60–90°E), so training on them would leak
-/// held-out terrain into the core.
-fn stage_data(stage: &str, dir: &Path, spec: ContextSpec) -> Result<(TileSet, TileSet), String> {
-    Ok((read_split(&dir.join(stage), "train", 1, spec)?, read_split(&dir.join(stage), "heldout", 1, spec)?))
-}
-
-/// Fits the relief hint of the shipped `<models>/<stage>.json` on the stage's training data
-/// (the crops and normalisation it was trained with) and writes it into the manifest; the
-/// weights are untouched. Training does the same when it ships.
-fn fit_relief_hint(models: &Path, stage: &str, data: &Path, features: usize) -> anyhow::Result<()> {
-    let path = models.join(format!("{stage}.json"));
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let manifest: ModelManifest =
-        serde_json::from_str(&text).with_context(|| format!("{} is not a model manifest", path.display()))?;
-    let (train, heldout) = stage_data(stage, data, manifest.context).map_err(|e| anyhow!(e))?;
-    let (crop, norm) = (manifest.training.crop, &manifest.normalisation);
-    let hint = train
-        .relief_hint(crop, norm, features)
-        .ok_or_else(|| anyhow!("{}: the relief-hint fit is singular on this data", data.display()))?;
-    println!(
-        "relief hint of {}: coefficients {:?} on {:?}, R² {:.3}",
-        path.display(),
-        hint.coefficients,
-        hint.features,
-        hint.r2
-    );
-    // The fit is judged on crops it never saw: a bias there is relief the hint will not ask for.
-    let (x, z) = heldout.relief_samples(crop, norm);
-    let check = hint.check(&x, &z);
-    println!(
-        "on {} held-out crops: R² {:.3}, truth − hint {:+.3} z (rms {:.3})",
-        z.len(),
-        check.r2,
-        check.bias,
-        check.rms
-    );
-    let hint = serde_json::to_value(&hint)?;
-    crate::lab::manifest_edit::edit_manifest(&path, |object| {
-        object.insert("relief_hint".into(), hint);
-        Ok(())
-    })
-}
-
-/// What a checkpoint records besides tensors.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-struct CheckpointState {
-    stage: String,
-    step: u64,
-    seed: u64,
-    batch: usize,
-    crop: usize,
-    lr: f32,
-    lr_ref_steps: u64,
-    ema: f32,
-    config: UNetConfig,
-    normalisation: Normalisation,
-    wall_seconds: f64,
-    /// (step, mean training loss over the logging interval).
-    losses: Vec<(u64, f32)>,
-    /// (step, validation loss).
-    validation: Vec<(u64, f32)>,
-    /// For a run started with `--init-from`: the command that made the weights it started
-    /// from, and that manifest's path (both go into the shipped `recreate`).
-    #[serde(default)]
-    continues: Option<(String, PathBuf)>,
-    /// Training noise levels (checkpoints written before they were recorded used EDM's).
-    #[serde(default)]
-    noise: NoiseDistribution,
-}
-
-/// Paths of a stage's checkpoint.
-struct CheckpointPaths {
-    dir: PathBuf,
-}
-
-impl CheckpointPaths {
-    fn state(&self) -> PathBuf {
-        self.dir.join("state.json")
-    }
-    fn model(&self) -> PathBuf {
-        self.dir.join("model.bpk")
-    }
-    fn ema(&self) -> PathBuf {
-        self.dir.join("ema.bpk")
-    }
-    fn optim(&self) -> PathBuf {
-        self.dir.join("optim.bpk")
-    }
-}
-
 /// Runs `infiniterra train`.
-pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
+pub fn run(args: &TrainOptions, seed: Option<u64>) -> Result<(), TrainError> {
     let mut spec = stage_spec(&args.stage, args.smoke)?;
     if args.half_width {
         spec.config = spec.config.halved();
@@ -359,49 +57,56 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
             seed.unwrap_or(DEFAULT_SEED),
             args.backend,
         )
-        .map_err(Failure::runtime);
+        .map_err(TrainError::runtime);
     }
     if let Some(out) = &args.generate_heldout {
         let seed = seed.unwrap_or(DEFAULT_SEED);
         return heldout::generate(&args.out, &args.stage, &args.data, out, args.tiles, args.draws, seed, args.backend)
-            .map_err(Failure::runtime);
+            .map_err(TrainError::runtime);
     }
     if args.fit_relief_hint {
-        return fit_relief_hint(&args.out, &args.stage, &args.data, args.hint_features()).map_err(Failure::runtime);
+        return relief_hint::fit_relief_hint(&args.out, &args.stage, &args.data, args.hint_features())
+            .map_err(TrainError::runtime);
     }
-    if args.calibrate_relief_response {
-        let seed = seed.unwrap_or(DEFAULT_SEED);
-        return response::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
-            .map_err(Failure::runtime);
-    }
-    if args.calibrate_spectrum {
-        let seed = seed.unwrap_or(DEFAULT_SEED);
-        return spectrum::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
-            .map_err(Failure::runtime);
-    }
-    if args.calibrate_infill {
-        let seed = seed.unwrap_or(DEFAULT_SEED);
-        return infill::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
-            .map_err(Failure::runtime);
-    }
-    if args.calibrate_relief_hint {
-        let seed = seed.unwrap_or(DEFAULT_SEED);
-        return calibrate::run(&args.out, &args.stage, &args.data, args.tiles, seed, args.backend)
-            .map_err(Failure::runtime);
+    let job = shipped::Calibration {
+        models: &args.out,
+        stage: &args.stage,
+        data: &args.data,
+        tiles: args.tiles,
+        seed: seed.unwrap_or(DEFAULT_SEED),
+        backend: args.backend,
+    };
+    let calibration = if args.calibrate_relief_response {
+        Some(response::run as fn(&shipped::Calibration) -> anyhow::Result<()>)
+    } else if args.calibrate_spectrum {
+        Some(spectrum::run as _)
+    } else if args.calibrate_infill {
+        Some(infill::run as _)
+    } else if args.calibrate_relief_hint {
+        Some(calibrate::run as _)
+    } else {
+        None
+    };
+    if let Some(calibrate) = calibration {
+        return calibrate(&job).map_err(TrainError::runtime);
     }
     if args.crop == 0 || args.crop % spec.config.size_multiple().max(8) != 0 {
-        return Err(Failure::input(anyhow!("--crop must be a positive multiple of 8, got {}", args.crop)));
+        return Err(TrainError::input(anyhow!("--crop must be a positive multiple of 8, got {}", args.crop)));
     }
     if args.batch == 0 || !(0.0..1.0).contains(&args.ema) || args.lr <= 0.0 {
-        return Err(Failure::input(anyhow!("--batch must be ≥ 1, --ema in [0, 1), --lr > 0")));
+        return Err(TrainError::input(anyhow!("--batch must be ≥ 1, --ema in [0, 1), --lr > 0")));
     }
     let (train, heldout) = if args.smoke {
         (data::synthetic_with(6, 128, spec.context), data::synthetic_with(2, 128, spec.context))
     } else {
-        stage_data(&args.stage, &args.data, spec.context).map_err(|e| Failure::input(anyhow!(e)))?
+        stage_data(&args.stage, &args.data, spec.context).map_err(|e| TrainError::input(anyhow!(e)))?
     };
     if train.min_tile() < args.crop {
-        return Err(Failure::input(anyhow!("--crop {} exceeds the smallest tile ({})", args.crop, train.min_tile())));
+        return Err(TrainError::input(anyhow!(
+            "--crop {} exceeds the smallest tile ({})",
+            args.crop,
+            train.min_tile()
+        )));
     }
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -415,380 +120,7 @@ pub fn run(args: &TrainArgs, seed: Option<u64>) -> Result<(), Failure> {
         });
     }
     let mut trainer = Trainer::new(args, seed.unwrap_or(DEFAULT_SEED), spec, train, heldout)?;
-    trainer.run(&stop).map_err(Failure::runtime)
-}
-
-/// A training run in progress.
-pub struct Trainer {
-    args: TrainArgs,
-    /// The stage's resolution, sampler, context and stride (what `ship` writes).
-    spec: StageSpec,
-    device: Device,
-    plain: Device,
-    net: UNet,
-    ema: UNet,
-    optim: ModuleOptimizer,
-    state: CheckpointState,
-    train: TileSet,
-    heldout: TileSet,
-    noise: NoiseDistribution,
-    paths: CheckpointPaths,
-}
-
-impl Trainer {
-    fn new(args: &TrainArgs, seed: u64, spec: StageSpec, train: TileSet, heldout: TileSet) -> Result<Trainer, Failure> {
-        let plain = args.backend.device().map_err(Failure::input)?;
-        let device = plain.clone().autodiff();
-        let paths = CheckpointPaths { dir: args.out.join("checkpoints").join(&args.stage) };
-        let optim = AdamConfig::new().with_beta_1(0.9).with_beta_2(0.99).with_epsilon(1e-8).init();
-        let (net, ema, optim, state) = if args.resume {
-            let text = std::fs::read_to_string(paths.state()).map_err(|e| {
-                Failure::input(anyhow!(
-                    "cannot resume: {} ({e}); start a new run without --resume",
-                    paths.state().display()
-                ))
-            })?;
-            let state: CheckpointState = serde_json::from_str(&text)
-                .map_err(|e| Failure::input(anyhow!("{} is not a checkpoint state: {e}", paths.state().display())))?;
-            if state.stage != args.stage || state.config != spec.config {
-                return Err(Failure::input(anyhow!(
-                    "{} belongs to another stage or architecture; start a new run without --resume",
-                    paths.state().display()
-                )));
-            }
-            let load = |path: PathBuf, dev: &Device| {
-                UNet::new(&state.config, state.seed, dev)
-                    .try_load_file(&path)
-                    .map_err(|e| Failure::input(anyhow!("cannot resume from {}: {e}", path.display())))
-            };
-            let net = load(paths.model(), &device)?;
-            let ema = load(paths.ema(), &plain)?;
-            let optim = optim
-                .load(paths.optim())
-                .map_err(|e| Failure::input(anyhow!("cannot resume from {}: {e}", paths.optim().display())))?;
-            eprintln!("resuming {} at step {} (seed {})", state.stage, state.step, state.seed);
-            (net, ema, optim, state)
-        } else if let Some(path) = &args.init_from {
-            let load =
-                |dev: &Device| load_model_file(path, dev).map_err(|e| Failure::input(anyhow!("--init-from: {e}")));
-            let shipped = load(&plain)?;
-            let m = &shipped.manifest;
-            if m.stage != args.stage || m.architecture != spec.config || m.context != spec.context {
-                return Err(Failure::input(anyhow!(
-                    "--init-from {}: a `{}` model of another architecture cannot continue as stage `{}`",
-                    path.display(),
-                    m.stage,
-                    args.stage
-                )));
-            }
-            let t = &m.training;
-            let state = CheckpointState {
-                stage: args.stage.clone(),
-                step: t.steps,
-                seed: t.seed,
-                batch: t.batch,
-                crop: t.crop,
-                lr: t.learning_rate,
-                lr_ref_steps: if t.lr_ref_steps > 0 { t.lr_ref_steps } else { args.lr_ref_steps },
-                ema: t.ema_beta,
-                config: m.architecture.clone(),
-                normalisation: m.normalisation.clone(),
-                wall_seconds: t.wall_seconds,
-                losses: Vec::new(),
-                validation: Vec::new(),
-                continues: Some((m.recreate.clone(), path.clone())),
-                noise: NoiseDistribution { p_mean: args.p_mean, p_std: args.p_std },
-            };
-            eprintln!(
-                "continuing {} from {} at step {} (seed {})",
-                state.stage,
-                path.display(),
-                state.step,
-                state.seed
-            );
-            let net = load(&device)?.net;
-            (net, shipped.net, optim, state)
-        } else {
-            let normalisation = train.normalisation(args.crop, spec.config.sigma_data);
-            let net = UNet::new(&spec.config, seed, &device);
-            let ema = UNet::new(&spec.config, seed, &plain);
-            let state = CheckpointState {
-                stage: args.stage.clone(),
-                step: 0,
-                seed,
-                batch: args.batch,
-                crop: args.crop,
-                lr: args.lr,
-                lr_ref_steps: args.lr_ref_steps,
-                ema: args.ema,
-                config: spec.config.clone(),
-                normalisation,
-                wall_seconds: 0.0,
-                losses: Vec::new(),
-                validation: Vec::new(),
-                continues: None,
-                noise: NoiseDistribution { p_mean: args.p_mean, p_std: args.p_std },
-            };
-            (net, ema, optim, state)
-        };
-        let noise = state.noise;
-        let mut t =
-            Trainer { args: args.clone(), spec, device, plain, net, ema, optim, state, train, heldout, noise, paths };
-        // A resumed run keeps its batch, crop and schedule: they define which samples each
-        // step sees, and changing them would silently make it a different run.
-        t.args.batch = t.state.batch;
-        t.args.crop = t.state.crop;
-        t.args.lr = t.state.lr;
-        t.args.lr_ref_steps = t.state.lr_ref_steps;
-        t.args.ema = t.state.ema;
-        Ok(t)
-    }
-
-    fn learning_rate(&self, step: u64) -> f64 {
-        let r = (step as f64 / self.state.lr_ref_steps.max(1) as f64).max(1.0);
-        self.state.lr as f64 / r.sqrt()
-    }
-
-    fn tensor4(&self, v: &[f32], b: usize, c: usize, s: usize, dev: &Device) -> Tensor<4> {
-        Tensor::from_data(TensorData::new(v.to_vec(), [b, c, s, s]), dev)
-    }
-
-    /// One optimiser step; returns the loss.
-    fn step(&mut self, batch: &Batch) -> f32 {
-        let (b, s) = (batch.size, batch.crop);
-        let dev = self.device.clone();
-        let clean = self.tensor4(&batch.clean, b, 1, s, &dev);
-        let noise = self.tensor4(&batch.noise, b, 1, s, &dev);
-        let cond = self.tensor4(&batch.cond, b, 1, s, &dev);
-        let vector = Tensor::<2>::from_data(TensorData::new(batch.vector.clone(), [b, 2]), &dev);
-        let loss = edm_loss(&self.net, clean, noise, &batch.sigma, Some(cond), Some(vector));
-        let value = loss.clone().inner().into_data().try_into_vec::<f32>().map(|v| v[0]).unwrap_or(f32::NAN);
-        let grads = GradientsParams::from_grads(loss.backward(), &self.net);
-        let lr = self.learning_rate(self.state.step);
-        self.net = force_normalize(self.optim.step(lr, self.net.clone(), grads));
-        // Warm-up of the EMA (as in many diffusion codebases): early on, average over the
-        // steps taken so far rather than over mostly-random initial weights.
-        let t = self.state.step as f32;
-        let beta = self.state.ema.min((1.0 + t) / (10.0 + t));
-        self.ema = ema::blend(self.ema.clone(), &self.net, beta);
-        self.state.step += 1;
-        value
-    }
-
-    /// Validation loss of the EMA network on a fixed held-out batch at fixed noise levels.
-    fn validate(&self, batch: &Batch) -> f32 {
-        let (b, s) = (batch.size, batch.crop);
-        let dev = &self.plain;
-        let loss = edm_loss(
-            &self.ema,
-            self.tensor4(&batch.clean, b, 1, s, dev),
-            self.tensor4(&batch.noise, b, 1, s, dev),
-            &batch.sigma,
-            Some(self.tensor4(&batch.cond, b, 1, s, dev)),
-            Some(Tensor::from_data(TensorData::new(batch.vector.clone(), [b, 2]), dev)),
-        );
-        loss.into_data().try_into_vec::<f32>().map(|v| v[0]).unwrap_or(f32::NAN)
-    }
-
-    fn run(&mut self, stop: &AtomicBool) -> anyhow::Result<()> {
-        let started = Instant::now();
-        let wall_before = self.state.wall_seconds;
-        let params = self.net.parameters();
-        let macs = self.net.macs_per_pixel();
-        eprintln!(
-            "training {}: {} parameters, {:.0} kMAC/pixel ({:.2} GFLOP per {}² sample forward), {} train / {} held-out tiles",
-            self.args.stage,
-            params,
-            macs / 1e3,
-            2.0 * macs * (self.args.crop * self.args.crop) as f64 / 1e9,
-            self.args.crop,
-            self.train.tiles.len(),
-            self.heldout.tiles.len()
-        );
-        let n = &self.state.normalisation;
-        eprintln!(
-            "normalisation: target_scale {:.3}, cond {:.2}±{:.2}, relief ln-std {:.2}±{:.2}; step {} of {}, batch {}, seed {}",
-            n.target_scale,
-            n.cond_mean,
-            n.cond_scale,
-            n.relief_mean,
-            n.relief_std,
-            self.state.step,
-            self.args.steps,
-            self.args.batch,
-            self.state.seed
-        );
-        // Fixed validation noise levels spread over the training distribution.
-        let mut val_batch = self.heldout.fixed_batch(16, self.args.crop, &self.state.normalisation, &self.noise);
-        val_batch.sigma = (0..16).map(|i| (-2.4 + 4.8 * i as f32 / 15.0).exp()).collect();
-        let preview_batch = self.heldout.fixed_batch(4, self.args.crop, &self.state.normalisation, &self.noise);
-
-        let (mut interval_loss, mut interval_n, mut interval_start) = (0f64, 0u64, Instant::now());
-        let start_step = self.state.step;
-        while self.state.step < self.args.steps {
-            let batch = self.train.batch(
-                self.state.seed,
-                self.state.step,
-                self.args.batch,
-                self.args.crop,
-                &self.state.normalisation,
-                &self.noise,
-            );
-            let loss = self.step(&batch);
-            if !loss.is_finite() {
-                self.checkpoint(wall_before + started.elapsed().as_secs_f64())?;
-                bail!("loss became {loss} at step {}: lower --lr and resume", self.state.step);
-            }
-            interval_loss += loss as f64;
-            interval_n += 1;
-            let step = self.state.step;
-            let timed_out = self.args.minutes.is_some_and(|m| started.elapsed().as_secs_f64() >= m * 60.0);
-            let done = step >= self.args.steps || stop.load(Ordering::SeqCst) || timed_out;
-            if step % self.args.log_every == 0 || done {
-                let secs = interval_start.elapsed().as_secs_f64().max(1e-9);
-                let rate = (interval_n as usize * self.args.batch) as f64 / secs;
-                let mean = (interval_loss / interval_n.max(1) as f64) as f32;
-                self.state.losses.push((step, mean));
-                let elapsed = started.elapsed().as_secs_f64();
-                let per_step = elapsed / (step - start_step).max(1) as f64;
-                let eta = per_step * (self.args.steps - step) as f64;
-                println!(
-                    "step {step}/{}  loss {mean:.4}  {rate:.1} samples/s  lr {:.2e}  elapsed {}  eta {}",
-                    self.args.steps,
-                    self.learning_rate(step),
-                    hms(elapsed),
-                    hms(eta)
-                );
-                (interval_loss, interval_n, interval_start) = (0.0, 0, Instant::now());
-            }
-            if step % self.args.preview_every == 0 || done {
-                let v = self.validate(&val_batch);
-                self.state.validation.push((step, v));
-                let png = self.paths.dir.join(format!("samples_{step:06}.png"));
-                preview::write(&png, &self.ema, &preview_batch, &self.state.normalisation, &self.plain)
-                    .with_context(|| format!("writing {}", png.display()))?;
-                println!("step {step}: validation loss {v:.4} (EMA), samples in {}", png.display());
-            }
-            if step % self.args.checkpoint_every == 0 || done {
-                self.checkpoint(wall_before + started.elapsed().as_secs_f64())?;
-            }
-            if done {
-                break;
-            }
-        }
-        self.state.wall_seconds = wall_before + started.elapsed().as_secs_f64();
-        self.ship()
-    }
-
-    /// Writes the checkpoint (model, EMA, optimiser, state), each through a temporary file
-    /// and the state last, so an interruption mid-write leaves the previous one usable.
-    fn checkpoint(&mut self, wall_seconds: f64) -> anyhow::Result<()> {
-        self.state.wall_seconds = wall_seconds;
-        std::fs::create_dir_all(&self.paths.dir).with_context(|| format!("creating {}", self.paths.dir.display()))?;
-        let tmp = |p: &Path| p.with_extension("tmp.bpk");
-        let (model, ema, optim) = (self.paths.model(), self.paths.ema(), self.paths.optim());
-        self.net.clone().save_file(tmp(&model)).map_err(|e| anyhow!("writing {}: {e}", model.display()))?;
-        self.ema.clone().save_file(tmp(&ema)).map_err(|e| anyhow!("writing {}: {e}", ema.display()))?;
-        self.optim.save(tmp(&optim)).map_err(|e| anyhow!("writing {}: {e}", optim.display()))?;
-        let state_tmp = self.paths.state().with_extension("json.tmp");
-        std::fs::write(&state_tmp, serde_json::to_string_pretty(&self.state)?)
-            .with_context(|| format!("writing {}", state_tmp.display()))?;
-        for p in [&model, &ema, &optim] {
-            std::fs::rename(tmp(p), p).with_context(|| format!("moving {} into place", p.display()))?;
-        }
-        std::fs::rename(&state_tmp, self.paths.state())
-            .with_context(|| format!("writing {}", self.paths.state().display()))?;
-        Ok(())
-    }
-
-    /// Writes the EMA weights and manifest to `<out>/<stage>.*`.
-    fn ship(&self) -> anyhow::Result<()> {
-        let mut manifest = ModelManifest::new(&self.args.stage, self.state.config.clone(), self.spec.sampler.clone());
-        manifest.metres_per_pixel = self.spec.metres_per_pixel;
-        manifest.window = 64;
-        manifest.stride = self.spec.stride;
-        manifest.context = self.spec.context;
-        manifest.context_projection = self.spec.projection.clone();
-        manifest.normalisation = self.state.normalisation.clone();
-        manifest.relief_hint =
-            self.train.relief_hint(self.state.crop, &self.state.normalisation, self.args.hint_features());
-        manifest.training = TrainingRecord {
-            steps: self.state.step,
-            batch: self.state.batch,
-            crop: self.state.crop,
-            seed: self.state.seed,
-            learning_rate: self.state.lr,
-            ema_beta: self.state.ema,
-            lr_ref_steps: self.state.lr_ref_steps,
-            noise: (self.state.noise != NoiseDistribution::default()).then_some(self.state.noise),
-            final_loss: self.state.losses.last().map_or(f32::NAN, |l| l.1),
-            wall_seconds: self.state.wall_seconds,
-        };
-        // Paths relative to the working directory when they lie below it, so the manifest
-        // reads the same on every checkout.
-        let cwd = std::env::current_dir().unwrap_or_default();
-        manifest.data = self
-            .train
-            .checksums
-            .iter()
-            .chain(&self.heldout.checksums)
-            .map(|c| {
-                let file = Path::new(&c.file).strip_prefix(&cwd).map_or(c.file.clone(), |p| p.display().to_string());
-                DataChecksum { file, sha256: c.sha256.clone() }
-            })
-            .collect();
-        // The command that reproduces these exact weights (a --minutes run stops at a
-        // machine-dependent step; this names the step it reached).
-        let s = &self.state;
-        let this_run = format!(
-            "infiniterra train {}{}{} --steps {} --seed {} --batch {} --crop {} --lr {} --lr-ref-steps {} --ema {}{} --precision {}",
-            s.stage,
-            // A guide is the half-width network in its own folder (`models/guide/`).
-            if self.args.half_width { format!(" --half-width --out {}", self.args.out.display()) } else { String::new() },
-            s.continues.as_ref().map_or(String::new(), |(_, from)| format!(" --init-from {}", from.display())),
-            s.step,
-            s.seed,
-            s.batch,
-            s.crop,
-            s.lr,
-            s.lr_ref_steps,
-            s.ema,
-            if s.noise == NoiseDistribution::default() {
-                String::new()
-            } else {
-                format!(" --p-mean {} --p-std {}", s.noise.p_mean, s.noise.p_std)
-            },
-            match self.args.precision {
-                Precision::F16 => "f16",
-                Precision::F32 => "f32",
-            }
-        );
-        // A continued run is reproduced by the commands that made its starting point, then
-        // this one (which reads the manifest the earlier ones wrote).
-        manifest.recreate = match &s.continues {
-            Some((before, _)) if !before.is_empty() => format!("{before} && {this_run}"),
-            _ => this_run,
-        };
-        if let Some(&(_, v)) = self.state.validation.last() {
-            manifest.realism.insert("validation_edm_loss".into(), v as f64);
-        }
-        let written = save_model(&self.args.out, &self.ema, manifest, self.args.precision)?;
-        println!(
-            "wrote {} ({} bytes, {} parameters, {} steps) and {}",
-            self.args.out.join(&written.weights).display(),
-            written.weights_bytes,
-            written.parameters,
-            written.training.steps,
-            self.args.out.join(format!("{}.json", written.stage)).display()
-        );
-        Ok(())
-    }
-}
-
-/// Seconds as h:mm:ss.
-fn hms(secs: f64) -> String {
-    let s = if secs.is_finite() { secs.max(0.0) as u64 } else { 0 };
-    format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+    trainer.run(&stop).map_err(TrainError::runtime)
 }
 
 #[cfg(test)]
