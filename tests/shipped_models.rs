@@ -19,7 +19,7 @@ fn repo() -> PathBuf {
 fn pipeline(learned: &[&str], threads: u64) -> Pipeline {
     let config = Config::load(&repo().join("config/server.toml")).expect("shipped config loads");
     let mut terrain = config.terrain();
-    terrain.engine.learned = learned.iter().map(|s| s.to_string()).collect();
+    terrain.engine.learned = learned.iter().map(|s| s.parse().expect("a learned stage")).collect();
     terrain.engine.models = repo().join("models");
     terrain.engine.threads = threads;
     Pipeline::build(config.world.seed, &terrain).expect("the shipped models build a pipeline")

@@ -121,6 +121,32 @@ mod tests {
         }
     }
 
+    /// `prepare.py` makes one set per learned stage at the stage's resolution: its `STAGES`
+    /// entries (name, metres) are the pipeline's stage table, in the same order.
+    #[test]
+    fn the_prepare_script_makes_the_stage_table_s_sets() {
+        let Ok(script) = locate("prepare.py") else { panic!("prepare.py is missing") };
+        let text = std::fs::read_to_string(script).expect("readable");
+        let block = text.split("\nSTAGES = [").nth(1).and_then(|b| b.split("\n]").next()).expect("a STAGES list");
+        let field = |entry: &str, key: &str| -> String {
+            let rest = entry.split(&format!("\"{key}\": ")).nth(1).unwrap_or_default();
+            rest.split([',', '}']).next().unwrap_or_default().trim().trim_matches('"').to_string()
+        };
+        let script_stages: Vec<(String, f64)> = block
+            .split("{\"name\"")
+            .skip(1)
+            .map(|e| {
+                let entry = format!("{{\"name\"{e}");
+                (field(&entry, "name"), field(&entry, "metres").parse().expect("metres is a number"))
+            })
+            .collect();
+        let table: Vec<(String, f64)> = crate::terrain::pipeline::stages::LEARNED
+            .iter()
+            .map(|s| (s.name.to_string(), s.metres_per_pixel))
+            .collect();
+        assert_eq!(script_stages, table);
+    }
+
     #[test]
     fn a_missing_interpreter_is_reported_by_name() {
         let args =

@@ -15,7 +15,7 @@ impl Trainer {
     pub(super) fn ship(&self) -> anyhow::Result<()> {
         let mut manifest = ModelManifest::new(&self.args.stage, self.state.config.clone(), self.spec.sampler.clone());
         manifest.metres_per_pixel = self.spec.metres_per_pixel;
-        manifest.window = 64;
+        manifest.window = self.spec.window;
         manifest.stride = self.spec.stride;
         manifest.context = self.spec.context;
         manifest.context_projection = self.spec.projection.clone();

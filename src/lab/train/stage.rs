@@ -1,74 +1,51 @@
-//! What each stage trains on and at what resolution: its grid, network, sampler, context,
-//! window stride and back-projection, and where its prepared tiles are read from.
+//! What each stage trains on and at what resolution — read from the pipeline's stage table
+//! (`infiniterra_terrain::pipeline::stages::LEARNED`) — and where its prepared tiles are read
+//! from.
 
 use std::path::Path;
 
 use anyhow::anyhow;
 use infiniterra_terrain::encoding::ContextSpec;
 use infiniterra_terrain::model::{ContextProjection, Sampler, UNetConfig};
+use infiniterra_terrain::pipeline::stages;
 
 use super::data::{read_split, TileSet};
 use super::TrainError;
 
-/// Back-projection passes of the core's windows onto their context cells.
-const PROJECTION_PASSES: usize = 4;
-
-/// What a stage trains on and at what resolution.
+/// What a stage trains on and at what resolution: its entry of the stage table
+/// ([`stages::LEARNED`]), made concrete.
 pub(super) struct StageSpec {
+    /// Real size of one of its pixels, metres.
     pub metres_per_pixel: f64,
+    /// Its network (tiny in smoke runs).
     pub config: UNetConfig,
+    /// The sampler it ships with.
     pub sampler: Sampler,
     /// How its context is made from the grid above it.
     pub context: ContextSpec,
+    /// Side of its windows, pixels.
+    pub window: usize,
     /// Window stride at inference (0: half the window).
     pub stride: usize,
     /// Back-projection of each window onto its context cells (unblurred contexts only).
     pub projection: Option<ContextProjection>,
 }
 
+/// The stage `stage` of the table; an input error listing the stages when there is none.
 pub(super) fn stage_spec(stage: &str, smoke: bool) -> Result<StageSpec, TrainError> {
-    let pick = |full: UNetConfig| if smoke { UNetConfig::tiny() } else { full };
-    match stage {
-        // 1 km relief over 8 km box means, unblurred: the blurred means of the paper's
-        // Laplacian split take the 16–64 km band out of the context, and a 64-pixel window
-        // cannot put it back (the first cores drew a third of its power, with or without
-        // window overlap); unblurred, the context carries it and the model draws what is
-        // finer than 8 km.
-        "core" => Ok(StageSpec {
-            metres_per_pixel: 1000.0,
-            config: pick(UNetConfig::core()),
-            sampler: Sampler::few_step(),
-            context: ContextSpec { factor: 8, blur: false },
-            stride: 0,
-            // Its windows missed their context cells by 23 m on held-out land, and part of the
-            // 16–45 km band with them (see `model::projection`).
-            projection: Some(ContextProjection { iterations: PROJECTION_PASSES }),
-        }),
-        // The same network one level up: 8 km relief (continents, shelves, basins) refining
-        // the layout's sketch from its blurred 16 km means. (The first coarse weights used
-        // 64 km means, as the core does one level down, and flattened the layout's narrower
-        // ranges: a 3,000 m range came out as 1,000 m blobs.)
-        "coarse" => Ok(StageSpec {
-            metres_per_pixel: 8000.0,
-            config: pick(UNetConfig::core()),
-            sampler: Sampler::few_step(),
-            context: ContextSpec { factor: 2, blur: true },
-            stride: 0,
-            projection: None,
-        }),
-        // The last stage: 500 m relief over the core's own 1 km grid, unblurred (the core's
-        // relief is kept; only what is finer than 1 km is generated), with the paper's 75 %
-        // window overlap for the decoder.
-        "detail" => Ok(StageSpec {
-            metres_per_pixel: 500.0,
-            config: pick(UNetConfig::detail()),
-            sampler: Sampler::few_step(),
-            context: ContextSpec { factor: 2, blur: false },
-            stride: 16,
-            projection: None,
-        }),
-        _ => Err(TrainError::input(anyhow!("unknown stage `{stage}` (stages: coarse, core, detail)"))),
-    }
+    let Some(spec) = stages::learned(stage) else {
+        let names = stages::learned_names().join(", ");
+        return Err(TrainError::input(anyhow!("unknown stage `{stage}` (stages: {names})")));
+    };
+    Ok(StageSpec {
+        metres_per_pixel: spec.metres_per_pixel,
+        config: if smoke { UNetConfig::tiny() } else { spec.network.config() },
+        sampler: spec.sampler.sampler(),
+        context: spec.context,
+        window: spec.window,
+        stride: spec.stride,
+        projection: spec.projection_passes.map(|iterations| ContextProjection { iterations }),
+    })
 }
 
 /// Loads a stage's prepared set (`<dir>/<stage>/`), train and held-out, encoded with the
