@@ -185,7 +185,7 @@ impl EngineSettings {
         check_range("engine.threads", self.threads, 1, 256)?;
         for stage in &self.learned {
             let spec = stage.spec();
-            for &required in spec.requires.iter().filter(|r| !self.learned.iter().any(|s| s == *r)) {
+            if let Some(&required) = spec.requires.iter().find(|r| !self.runs(r)) {
                 let why = if required == spec.context_stage {
                     format!("it refines the {required}'s relief")
                 } else {
