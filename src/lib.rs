@@ -5,19 +5,17 @@
 //! benchmarks and (later) the Minecraft server. The terrain itself lives in the
 //! `infiniterra-terrain` crate, which knows nothing of Minecraft.
 
-pub mod bench;
 pub mod biome;
 pub mod cli;
 pub mod config;
-pub mod eval;
+pub mod draw;
 pub mod export;
 pub mod chunkgen;
-pub mod manifest_edit;
+pub mod lab;
+pub mod npy;
 pub mod pregen;
 pub mod render;
 pub mod server;
-#[cfg(feature = "learned")]
-pub mod train;
 pub mod world;
 
 pub use infiniterra_terrain as terrain;

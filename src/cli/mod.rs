@@ -3,6 +3,7 @@
 //! or bad input).
 
 mod args;
+mod lab;
 mod maps;
 mod progress;
 
@@ -44,12 +45,12 @@ pub enum Command {
     /// Write raw elevation (float32 metres, .npy) of a rectangle, with a JSON sidecar.
     Export(maps::ExportArgs),
     /// Fetch or prepare the real elevation data the models learn from.
-    Data(crate::eval::DataArgs),
+    Data(lab::DataArgs),
     /// Measure how realistic generated terrain is against real terrain.
-    Eval(crate::eval::EvalArgs),
+    Eval(lab::EvalArgs),
     /// Train a stage of the model hierarchy (`--seed` sets the training seed).
     #[cfg(feature = "learned")]
-    Train(crate::train::TrainArgs),
+    Train(lab::TrainArgs),
     /// Train a stage of the model hierarchy (needs the default `learned` feature).
     #[cfg(not(feature = "learned"))]
     Train {
@@ -60,7 +61,7 @@ pub enum Command {
     /// Pre-generate a region into Anvil files without a server (resumable; shardable).
     Pregen(crate::pregen::batch::PregenArgs),
     /// Measure the engine and the pipeline on this machine.
-    Bench(crate::bench::BenchArgs),
+    Bench(lab::BenchArgs),
 }
 
 /// A failure with the exit code it maps to.
@@ -117,28 +118,31 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         }
         Command::Render(a) => maps::render(&load_config(&cli)?, a),
         Command::Export(a) => maps::export(&load_config(&cli)?, a),
-        Command::Data(a) => crate::eval::data::run(a).map_err(Failure::runtime),
+        Command::Data(a) => crate::lab::data::run(&a.into()).map_err(Failure::runtime),
         Command::Eval(a) => {
             let mut progress = progress::Progress::new("eval", "tiles");
-            let report = crate::eval::run(a, &mut |d, t| progress.update(d, t));
+            let report = crate::lab::eval::run(&a.into(), &mut |d, t| progress.update(d, t));
             progress.finish();
             match report {
                 Ok(report) => {
                     println!("{report}\nwrote {}", a.out.display());
                     Ok(())
                 }
-                Err(e @ crate::eval::EvalError::Input(_)) => Err(Failure::input(e)),
+                Err(e @ crate::lab::eval::EvalError::Input(_)) => Err(Failure::input(e)),
                 Err(e) => Err(Failure::runtime(e)),
             }
         }
         #[cfg(feature = "learned")]
-        Command::Train(a) => crate::train::run(a, cli.seed),
+        Command::Train(a) => crate::lab::train::run(&a.into(), cli.seed).map_err(|e| match e {
+            crate::lab::train::TrainError::Input(e) => Failure::input(e),
+            crate::lab::train::TrainError::Runtime(e) => Failure::runtime(e),
+        }),
         #[cfg(not(feature = "learned"))]
         Command::Train { .. } => Err(Failure::runtime(anyhow::anyhow!(
             "this binary was built without the learned-model code (--no-default-features): \
              build with the default features (`cargo run --release -- train STAGE`)"
         ))),
         Command::Pregen(a) => crate::pregen::batch::run(&load_config(&cli)?, a),
-        Command::Bench(a) => crate::bench::run(&load_config(&cli)?, a).map_err(Failure::runtime),
+        Command::Bench(a) => crate::lab::bench::run(&load_config(&cli)?, &a.into()).map_err(Failure::runtime),
     }
 }

@@ -8,8 +8,8 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::npy::tmp_path;
 use super::ExportError;
+use crate::npy::tmp_path;
 use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
 
 /// Which grid an export samples.

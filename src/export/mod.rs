@@ -1,22 +1,20 @@
 //! `infiniterra export`: raw heightmaps for analysis — elevation in metres as a NumPy `.npy`
 //! array (row-major z then x) with a JSON sidecar saying where it lies and how it was made.
 //!
-//! Owns: the `.npy` reader and writer, the sidecar format ([`ExportMeta`]), streaming a
+//! Owns: the sidecar format ([`ExportMeta`]), streaming a
 //! region out of the pipeline. Must not touch: terrain internals (only `Pipeline::model` /
 //! `Pipeline::columns`), the command line.
 
 mod meta;
-mod npy;
 
 use std::path::{Path, PathBuf};
 
 pub use meta::{ExportMeta, Grid, UnknownGrid, Vertical};
-pub use npy::{read_npy_f32, write_npy_f32, NpyError};
 
+use crate::npy::NpyWriter;
 use crate::terrain::pipeline::channel;
 use crate::terrain::tile::div_floor;
 use crate::terrain::{Pipeline, Rect, Tile};
-use npy::NpyWriter;
 
 /// Cells fetched per pipeline query: large enough to amortise per-query work, small enough
 /// (~20 MB of five-channel answers) that huge exports stream in bounded memory.

@@ -2,6 +2,7 @@
 //! the pipeline's own answers.
 
 use super::*;
+use crate::npy::read_npy_f32;
 use crate::terrain::TerrainSettings;
 
 const VERTICAL: Vertical = Vertical { sea_level_y: 63, metres_per_block: 20.0 };

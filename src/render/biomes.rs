@@ -6,9 +6,10 @@ use std::collections::HashMap;
 
 use image::{Rgb, RgbImage};
 
-use super::{check, panel, text, title_lines, RenderError, RenderRequest};
+use super::{check, panel, title_lines, RenderError, RenderRequest};
 use crate::biome::BiomeRules;
 use crate::chunkgen::Generator;
+use crate::draw;
 
 /// Map colours of the biomes, close to the ones players know from biome-map tools.
 const COLOURS: &[(&str, [u8; 3])] = &[
@@ -104,8 +105,8 @@ fn frame(map: RgbImage, title: &[String], counts: HashMap<String, u64>) -> RgbIm
     biomes.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
     let frame_width = map.width().max(panel::MIN_FRAME_WIDTH);
     let scale = panel::text_scale(frame_width);
-    let line = (text::GLYPH + 4) * scale;
-    let column = 34 * text::GLYPH * scale;
+    let line = (draw::GLYPH + 4) * scale;
+    let column = 34 * draw::GLYPH * scale;
     let per_row = (frame_width / column).max(1) as usize;
     let rows = biomes.len().div_ceil(per_row) as u32;
     let margin = 8 * scale;
@@ -115,7 +116,7 @@ fn frame(map: RgbImage, title: &[String], counts: HashMap<String, u64>) -> RgbIm
     let ink = Rgb([20, 20, 20]);
     let mut y = (map.height() + margin) as i64;
     for t in title {
-        text::draw(&mut img, margin as i64, y, t, scale, ink);
+        draw::text(&mut img, margin as i64, y, t, scale, ink);
         y += line as i64;
     }
     y += margin as i64;
@@ -123,10 +124,10 @@ fn frame(map: RgbImage, title: &[String], counts: HashMap<String, u64>) -> RgbIm
     for (i, (name, n)) in biomes.iter().enumerate() {
         let x = (margin + (i % per_row) as u32 * column) as i64;
         let row_y = y + (i / per_row) as i64 * line as i64;
-        text::fill(&mut img, x, row_y, text::GLYPH * scale, text::GLYPH * scale, colour(name));
+        draw::fill(&mut img, x, row_y, draw::GLYPH * scale, draw::GLYPH * scale, colour(name));
         let label =
             format!("{} {:.1}%", name.strip_prefix("minecraft:").unwrap_or(name), 100.0 * *n as f64 / total as f64);
-        text::draw(&mut img, x + (text::GLYPH * scale + 4 * scale) as i64, row_y, &label, scale, ink);
+        draw::text(&mut img, x + (draw::GLYPH * scale + 4 * scale) as i64, row_y, &label, scale, ink);
     }
     img
 }

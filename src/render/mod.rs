@@ -11,7 +11,6 @@ mod panel;
 mod ramp;
 mod sample;
 mod shade;
-mod text;
 
 use std::path::{Path, PathBuf};
 

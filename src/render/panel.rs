@@ -4,7 +4,7 @@
 use image::{Rgb, RgbImage};
 
 use super::ramp::to_rgb;
-use super::text::{self, GLYPH};
+use crate::draw::{self, outline, GLYPH};
 
 /// Panel background.
 pub(crate) const BACKGROUND: Rgb<u8> = Rgb([250, 250, 248]);
@@ -60,12 +60,12 @@ pub(crate) fn height(scale: u32) -> u32 {
 /// Draws the panel into the rows of `img` from `top` down.
 pub(crate) fn draw(img: &mut RgbImage, top: u32, title: &[String], legend: &Legend, metres_per_px: f64, scale: u32) {
     let width = img.width();
-    text::fill(img, 0, top as i64, width, img.height() - top, BACKGROUND);
+    draw::fill(img, 0, top as i64, width, img.height() - top, BACKGROUND);
     let s = scale as i64;
     let margin = MARGIN as i64 * s;
     let mut y = top as i64 + margin;
     for line in title {
-        text::draw(img, margin, y, line, scale, INK);
+        draw::text(img, margin, y, line, scale, INK);
         y += LINE as i64 * s;
     }
     y += margin;
@@ -77,13 +77,13 @@ pub(crate) fn draw(img: &mut RgbImage, top: u32, title: &[String], legend: &Lege
 /// Draws the legend at (`x`, `y`); returns the y below it.
 fn draw_legend(img: &mut RgbImage, x: i64, y: i64, legend: &Legend, scale: u32) -> i64 {
     let s = scale as i64;
-    text::draw(img, x, y, legend.caption, scale, INK);
+    draw::text(img, x, y, legend.caption, scale, INK);
     let bar_top = y + LINE as i64 * s;
     let bar_w = (img.width() as i64 - 2 * x).min(400 * s).max(1);
     let bar_h = BAR * scale;
     for i in 0..bar_w {
         let value = (legend.value_at)((i as f32 + 0.5) / bar_w as f32);
-        text::fill(img, x + i, bar_top, 1, bar_h, to_rgb((legend.colour)(value)));
+        draw::fill(img, x + i, bar_top, 1, bar_h, to_rgb((legend.colour)(value)));
     }
     outline(img, x, bar_top, bar_w, bar_h as i64, INK);
 
@@ -94,12 +94,12 @@ fn draw_legend(img: &mut RgbImage, x: i64, y: i64, legend: &Legend, scale: u32) 
     let mut free_from = i64::MIN;
     for &v in legend.ticks {
         let tx = x + ((legend.position_of)(v).clamp(0.0, 1.0) * (bar_w - 1) as f32).round() as i64;
-        text::fill(img, tx, tick_top, scale, TICK * scale, INK);
+        draw::fill(img, tx, tick_top, scale, TICK * scale, INK);
         let label = number(v);
-        let lw = text::width(&label, scale) as i64;
+        let lw = draw::width(&label, scale) as i64;
         let lx = (tx - lw / 2).clamp(0, (img.width() as i64 - lw).max(0));
         if lx >= free_from {
-            text::draw(img, lx, label_top, &label, scale, INK);
+            draw::text(img, lx, label_top, &label, scale, INK);
             free_from = lx + lw + GLYPH as i64 * s;
         }
     }
@@ -116,14 +116,14 @@ fn draw_scale_bar(img: &mut RgbImage, x: i64, y: i64, metres_per_px: f64, scale:
     let px = ((km * 1000.0 / metres_per_px).round() as i64).max(1);
     let blocks = km * 1000.0 / block_metres;
     let label = format!("{} blocks = {} km", number(blocks as f32), number(km as f32));
-    text::draw(img, x, y, &label, scale, INK);
+    draw::text(img, x, y, &label, scale, INK);
     let bar_top = y + LINE as i64 * s;
     let bar_h = (SCALE_BAR * scale) as i64;
     // Alternating quarters, as on printed maps, so fractions of the length can be read off.
     for q in 0..4 {
         let (a, b) = (x + px * q / 4, x + px * (q + 1) / 4);
         let colour = if q % 2 == 0 { INK } else { GREY };
-        text::fill(img, a, bar_top, (b - a).max(1) as u32, bar_h as u32, colour);
+        draw::fill(img, a, bar_top, (b - a).max(1) as u32, bar_h as u32, colour);
     }
     outline(img, x, bar_top, px, bar_h, INK);
 }
@@ -151,15 +151,6 @@ fn number(v: f32) -> String {
     } else {
         format!("{v:.1}")
     }
-}
-
-/// A one-pixel outline around a rectangle.
-fn outline(img: &mut RgbImage, x: i64, y: i64, w: i64, h: i64, colour: Rgb<u8>) {
-    let (w, h) = (w.max(1), h.max(1));
-    text::fill(img, x - 1, y - 1, w as u32 + 2, 1, colour);
-    text::fill(img, x - 1, y + h, w as u32 + 2, 1, colour);
-    text::fill(img, x - 1, y, 1, h as u32, colour);
-    text::fill(img, x + w, y, 1, h as u32, colour);
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@ use serde::Deserialize;
 
 pub use crate::climate::ClimateSettings;
 pub use crate::layout::LayoutSettings;
+use crate::pipeline::stages::{self, LearnedStageSpec};
 
 /// A setting outside its allowed range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -32,6 +33,122 @@ pub fn check_range<T: PartialOrd + std::fmt::Display>(key: &str, value: T, min: 
     }
 }
 
+/// A learned stage named in `engine.learned`: always an entry of the stage table
+/// ([`stages::LEARNED`]), so code holding one never meets an unknown name.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct StageName(&'static str);
+
+impl StageName {
+    /// The stage's name.
+    pub fn as_str(self) -> &'static str {
+        self.0
+    }
+
+    /// The stage's entry in the table.
+    pub fn spec(self) -> &'static LearnedStageSpec {
+        stages::learned(self.0).expect("a StageName is always in the table")
+    }
+}
+
+impl std::str::FromStr for StageName {
+    type Err = RangeError;
+
+    /// The stage called `s`; an error naming `engine.learned` and the stages that exist.
+    fn from_str(s: &str) -> Result<StageName, RangeError> {
+        stages::learned(s).map(|spec| StageName(spec.name)).ok_or_else(|| RangeError {
+            key: "engine.learned".into(),
+            value: format!("{s:?}"),
+            allowed: format!("stages with a model: {:?}", stages::learned_names()),
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for StageName {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<StageName, D::Error> {
+        String::deserialize(d)?.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl std::fmt::Display for StageName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+/// Written as the quoted name (`"core"`), as it appears in the configuration.
+impl std::fmt::Debug for StageName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.0)
+    }
+}
+
+impl PartialEq<str> for StageName {
+    fn eq(&self, other: &str) -> bool {
+        self.0 == other
+    }
+}
+
+impl PartialEq<&str> for StageName {
+    fn eq(&self, other: &&str) -> bool {
+        self.0 == *other
+    }
+}
+
+impl PartialEq<String> for StageName {
+    fn eq(&self, other: &String) -> bool {
+        self.0 == other
+    }
+}
+
+/// Where the learned stages run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Backend {
+    /// burn's pure-Rust CPU backend.
+    #[default]
+    Cpu,
+    /// burn's wgpu backend (needs the `wgpu` build feature).
+    Wgpu,
+}
+
+impl Backend {
+    /// The name in the configuration (`"cpu"`, `"wgpu"`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+            Backend::Wgpu => "wgpu",
+        }
+    }
+}
+
+impl std::str::FromStr for Backend {
+    type Err = RangeError;
+
+    /// The backend called `s`; an error naming `engine.backend` and the backends that exist.
+    fn from_str(s: &str) -> Result<Backend, RangeError> {
+        match s {
+            "cpu" => Ok(Backend::Cpu),
+            "wgpu" => Ok(Backend::Wgpu),
+            _ => Err(RangeError {
+                key: "engine.backend".into(),
+                value: format!("{s:?}"),
+                allowed: "\"cpu\" or \"wgpu\"".into(),
+            }),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Backend {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Backend, D::Error> {
+        String::deserialize(d)?.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl std::fmt::Display for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// The engine's cache and threads, and which learned stages run, as the owner sets them.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -40,16 +157,13 @@ pub struct EngineSettings {
     pub cache_mib: u64,
     /// Threads evaluating missing windows of one query.
     pub threads: u64,
-    /// Learned stages to run, by name (`"core"`); empty: the procedural layout stands in.
-    pub learned: Vec<String>,
+    /// Learned stages to run (`["core"]`); empty: the procedural layout stands in.
+    pub learned: Vec<StageName>,
     /// Folder of the weights (`<stage>.json` manifest + `<stage>.safetensors`).
     pub models: PathBuf,
-    /// Backend of the learned stages: `"cpu"` (burn's pure-Rust backend) or `"wgpu"`.
-    pub backend: String,
+    /// Backend of the learned stages.
+    pub backend: Backend,
 }
-
-/// Learned stages that exist (have code and can be trained).
-pub const LEARNED_STAGES: [&str; 3] = ["coarse", "core", "detail"];
 
 impl Default for EngineSettings {
     fn default() -> Self {
@@ -58,41 +172,38 @@ impl Default for EngineSettings {
             threads: 2,
             learned: Vec::new(),
             models: PathBuf::from("models"),
-            backend: "cpu".into(),
+            backend: Backend::Cpu,
         }
     }
 }
 
 impl EngineSettings {
-    /// Checks every value against its range.
+    /// Checks every value against its range, and that every learned stage's required stages
+    /// run too (names and backends are checked when they are parsed).
     pub fn validate(&self) -> Result<(), RangeError> {
         check_range("engine.cache_mib", self.cache_mib, 1, 65_536)?;
         check_range("engine.threads", self.threads, 1, 256)?;
-        if !["cpu", "wgpu"].contains(&self.backend.as_str()) {
-            return Err(RangeError {
-                key: "engine.backend".into(),
-                value: format!("{:?}", self.backend),
-                allowed: "\"cpu\" or \"wgpu\"".into(),
-            });
-        }
         for stage in &self.learned {
-            if !LEARNED_STAGES.contains(&stage.as_str()) {
+            let spec = stage.spec();
+            if let Some(&required) = spec.requires.iter().find(|r| !self.runs(r)) {
+                let why = if required == spec.context_stage {
+                    format!("it refines the {required}'s relief")
+                } else {
+                    format!("it needs the {required} stage")
+                };
                 return Err(RangeError {
                     key: "engine.learned".into(),
-                    value: format!("{stage:?}"),
-                    allowed: format!("stages with a model: {:?}", LEARNED_STAGES),
+                    value: format!("{:?}", self.learned),
+                    allowed: format!("{stage:?} only together with {required:?} ({why})"),
                 });
             }
         }
-        // The detail model refines the core's output; without the core it has nothing to refine.
-        if self.learned.iter().any(|s| s == "detail") && !self.learned.iter().any(|s| s == "core") {
-            return Err(RangeError {
-                key: "engine.learned".into(),
-                value: format!("{:?}", self.learned),
-                allowed: "\"detail\" only together with \"core\" (it refines the core's relief)".into(),
-            });
-        }
         Ok(())
+    }
+
+    /// Whether the learned stage `name` runs.
+    pub fn runs(&self, name: &str) -> bool {
+        self.learned.iter().any(|s| s == name)
     }
 }
 

@@ -60,7 +60,7 @@ pub fn procedural_pipeline(config: &Config) -> Pipeline {
 /// engine threads (the output is the same bits whatever the thread count).
 pub fn learned_pipeline(config: &Config, learned: &[&str], threads: u64) -> Pipeline {
     let mut terrain = config.terrain();
-    terrain.engine.learned = learned.iter().map(|s| s.to_string()).collect();
+    terrain.engine.learned = learned.iter().map(|s| s.parse().expect("a learned stage")).collect();
     terrain.engine.models = shipped_models();
     terrain.engine.threads = threads;
     Pipeline::build(config.world.seed, &terrain).expect("the shipped models build a pipeline")

@@ -1,21 +1,21 @@
 //! The pipeline facade: one call answers "elevation (m) and the four climate values for
 //! every block column of this rectangle".
 //!
-//! Owns: the stage list (coarse → core → detail, as data), the grids they live on, the 4×
-//! upsampling from model pixels to blocks. Must not touch: Minecraft (block ids, biomes,
+//! Owns: the stage list (coarse → core → detail, as data in [`stages::LEARNED`]), the grids
+//! they live on, the 4× upsampling from model pixels to blocks. Must not touch: Minecraft (block ids, biomes,
 //! chunks) — callers map metres and climate to blocks themselves.
 
-mod stages;
+pub mod stages;
 
 use std::sync::Arc;
 
-pub use stages::{StageState, StageStatus};
+pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 
 use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
-use crate::settings::TerrainSettings;
+use crate::settings::{StageName, TerrainSettings};
 use crate::tile::{Rect, Tile};
 use crate::upsample;
 
@@ -54,7 +54,7 @@ pub enum PipelineError {
          (--no-default-features): build with the default features (`cargo build --release`), or set \
          `learned = []` for the procedural layout alone"
     )]
-    NotBuilt(Vec<String>),
+    NotBuilt(Vec<StageName>),
     /// A model could not be loaded (the message names the file and the command that makes it).
     #[cfg(feature = "learned")]
     #[error(transparent)]
@@ -148,14 +148,19 @@ impl Pipeline {
         let layout = Layout::new(seed, &settings.layout);
         let coarse_metres = MODEL_PIXEL_METRES * COARSE_FACTOR as f64;
         let mut stages = stages::current();
-        let sketch_elevation: Arc<dyn Source> = Arc::new(layout.elevation(coarse_metres));
-        let learned = |name: &str| settings.engine.learned.iter().any(|s| s == name);
-        let coarse_elevation: Arc<dyn Source> = if learned("coarse") {
-            // The coarse model refines the layout's sketch on the sketch's own 8 km grid.
-            let stage = learned_stage("coarse", seed, settings, &engine, sketch_elevation, coarse_metres, &mut stages)?;
-            stage.on_grid(coarse_metres)?
-        } else {
-            sketch_elevation
+        let sketch = StageGrid::layout(Arc::new(layout.elevation(coarse_metres)), coarse_metres);
+        // The learned stages, coarse to fine, each refining the output of its context stage
+        // (the layout's sketch when that stage is off).
+        let mut ran: Vec<StageGrid> = Vec::new();
+        for spec in LEARNED.iter().filter(|s| settings.engine.runs(s.name)) {
+            let above = ran.iter().rev().find(|g| g.name == spec.context_stage).unwrap_or(&sketch);
+            let grid = learned_stage(spec, seed, settings, &engine, above, &mut stages)?;
+            ran.push(grid);
+        }
+        // The coarse grid (climate, spawn search) carries the finest stage that lives on it.
+        let coarse_elevation = match ran.iter().rev().find(|g| g.metres == coarse_metres) {
+            Some(grid) => grid.clone().on_grid(coarse_metres)?,
+            None => sketch.source.clone(),
         };
         let coarse_sketch: Arc<dyn Source> = Arc::new(layout.climate_sketch(coarse_metres));
         let precipitation = Windowed::new(
@@ -170,22 +175,10 @@ impl Pipeline {
                 margin: 48,
             },
         );
-        let elevation: Arc<dyn Source> = if learned("core") {
-            let core =
-                learned_stage("core", seed, settings, &engine, coarse_elevation.clone(), coarse_metres, &mut stages)?;
-            if learned("detail") {
-                // The detail model adds the high-frequency residual over the core's own grid.
-                let (context, metres) = (core.source, core.metres);
-                learned_stage("detail", seed, settings, &engine, context, metres, &mut stages)?
-                    .on_grid(MODEL_PIXEL_METRES)?
-            } else {
-                core.on_grid(MODEL_PIXEL_METRES)?
-            }
-        } else if settings.engine.learned.is_empty() {
-            Arc::new(layout.elevation(MODEL_PIXEL_METRES))
-        } else {
-            // Coarse alone: its relief, bilinearly brought to the model grid.
-            Arc::new(Upsampled { source: coarse_elevation.clone(), factor: COARSE_FACTOR })
+        // The model grid carries the finest stage that ran, bilinearly brought down to it.
+        let elevation: Arc<dyn Source> = match ran.pop() {
+            Some(finest) => finest.on_grid(MODEL_PIXEL_METRES)?,
+            None => Arc::new(layout.elevation(MODEL_PIXEL_METRES)),
         };
         Ok(Pipeline {
             seed,
@@ -214,12 +207,12 @@ impl Pipeline {
         &self.stages
     }
 
-    /// Names of the learned stages that run (a subset of
-    /// [`LEARNED_STAGES`](crate::settings::LEARNED_STAGES)); empty for the procedural layout.
+    /// Names of the learned stages that run (a subset of [`LEARNED`]'s); empty for the
+    /// procedural layout.
     pub fn learned_stages(&self) -> Vec<&'static str> {
         self.stages
             .iter()
-            .filter(|s| s.state == StageState::Active && crate::settings::LEARNED_STAGES.contains(&s.name))
+            .filter(|s| s.state == StageState::Active && stages::learned(s.name).is_some())
             .map(|s| s.name)
             .collect()
     }
@@ -299,8 +292,8 @@ impl Pipeline {
     }
 }
 
-/// A learned stage's output on its own grid.
-#[cfg_attr(not(feature = "learned"), allow(dead_code))]
+/// A stage's output on its own grid: a learned stage's, or the layout's sketch.
+#[derive(Clone)]
 struct StageGrid {
     /// The stage's window function behind the engine's cache.
     source: Arc<dyn Source>,
@@ -308,11 +301,16 @@ struct StageGrid {
     metres: f64,
     /// Its manifest (for errors).
     file: String,
-    /// Its name.
-    name: String,
+    /// Its name (`layout` for the sketch).
+    name: &'static str,
 }
 
 impl StageGrid {
+    /// The layout's sketch on its grid of `metres`.
+    fn layout(source: Arc<dyn Source>, metres: f64) -> StageGrid {
+        StageGrid { source, metres, file: String::new(), name: "layout" }
+    }
+
     /// The stage brought to a grid of `target` metres by exact bilinear upsampling (its own
     /// grid must be a whole multiple of the target's).
     fn on_grid(self, target: f64) -> Result<Arc<dyn Source>, PipelineError> {
@@ -320,7 +318,7 @@ impl StageGrid {
         if factor < 1.0 || (factor - factor.round()).abs() > 1e-6 {
             return Err(PipelineError::Resolution {
                 file: self.file,
-                stage: self.name,
+                stage: self.name.to_string(),
                 found: self.metres,
                 needed: format!("a whole multiple of {target} m per pixel"),
             });
@@ -333,25 +331,36 @@ impl StageGrid {
     }
 }
 
-/// The learned stage `name` (`models/<name>.json`), conditioned on `context` (metres on a grid
-/// of `context_metres`; box-averaged further when the model's context, `context.factor` of
-/// its own pixels, is coarser than that). Marks the stage active.
+/// The learned stage `spec` (`<engine.models>/<name>.json`), conditioned on `above` (box-
+/// averaged further when the model's context, `context.factor` of its own pixels, is coarser
+/// than `above`'s grid). Marks the stage active.
 #[cfg(feature = "learned")]
 fn learned_stage(
-    name: &str,
+    spec: &LearnedStageSpec,
     seed: u64,
     settings: &TerrainSettings,
     engine: &Arc<Engine>,
-    context: Arc<dyn Source>,
-    context_metres: f64,
+    above: &StageGrid,
     stages: &mut [StageStatus],
 ) -> Result<StageGrid, PipelineError> {
     use crate::model::{load_model, stage::LearnedStage, ComputeBackend};
-    let backend: ComputeBackend = settings.engine.backend.parse()?;
+    let name = spec.name;
+    let backend: ComputeBackend = settings.engine.backend.as_str().parse()?;
     let device = backend.device()?;
     let model = load_model(&settings.engine.models, name, &device)?;
     let file = settings.engine.models.join(format!("{name}.json")).display().to_string();
     let metres = model.manifest.metres_per_pixel;
+    // The stage's place in the hierarchy is its grid: a model trained at another resolution
+    // would put its relief at the wrong scale.
+    if (metres - spec.metres_per_pixel).abs() > 1e-6 * spec.metres_per_pixel {
+        return Err(PipelineError::Resolution {
+            file,
+            stage: name.to_string(),
+            found: metres,
+            needed: format!("{} m per pixel", spec.metres_per_pixel),
+        });
+    }
+    let context_metres = above.metres;
     let cell = metres * model.manifest.context.factor as f64;
     let ratio = cell / context_metres;
     if ratio < 1.0 - 1e-6 || (ratio - ratio.round()).abs() > 1e-6 {
@@ -365,24 +374,23 @@ fn learned_stage(
         });
     }
     let context: Arc<dyn Source> = match ratio.round() as i64 {
-        1 => context,
-        factor => Arc::new(BoxMean { source: context, factor }),
+        1 => above.source.clone(),
+        factor => Arc::new(BoxMean { source: above.source.clone(), factor }),
     };
     let source = Windowed::new(engine, LearnedStage::new(model, device, context, seed, 8));
     for s in stages.iter_mut().filter(|s| s.name == name) {
         s.state = StageState::Active;
     }
-    Ok(StageGrid { source, metres, file, name: name.to_string() })
+    Ok(StageGrid { source, metres, file, name })
 }
 
 #[cfg(not(feature = "learned"))]
 fn learned_stage(
-    _name: &str,
+    _spec: &LearnedStageSpec,
     _seed: u64,
     settings: &TerrainSettings,
     _engine: &Arc<Engine>,
-    _context: Arc<dyn Source>,
-    _context_metres: f64,
+    _above: &StageGrid,
     _stages: &mut [StageStatus],
 ) -> Result<StageGrid, PipelineError> {
     Err(PipelineError::NotBuilt(settings.engine.learned.clone()))

@@ -159,7 +159,7 @@ fn temperature_is_the_sea_level_field_minus_the_lapse_rate() {
 #[test]
 fn learned_stages_in_a_build_without_them_say_how_to_build() {
     let mut settings = TerrainSettings::default();
-    settings.engine.learned = vec!["core".into()];
+    settings.engine.learned = vec!["core".parse().expect("a stage")];
     let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
     assert!(err.contains("core") && err.contains("--no-default-features") && err.contains("learned = []"), "{err}");
 }
@@ -208,9 +208,9 @@ mod learned {
         let engine = EngineSettings {
             cache_mib,
             threads,
-            learned: stages.iter().map(|s| s.to_string()).collect(),
+            learned: stages.iter().map(|s| s.parse().expect("a stage")).collect(),
             models: models.to_path_buf(),
-            backend: "cpu".into(),
+            backend: crate::settings::Backend::Cpu,
         };
         Pipeline::build(seed, &TerrainSettings { engine, ..Default::default() }).expect("learned pipeline")
     }
@@ -292,7 +292,7 @@ mod learned {
         assert_ne!(d, c);
         // Detail without the core is refused by the settings.
         let mut settings = TerrainSettings::default();
-        settings.engine.learned = vec!["detail".into()];
+        settings.engine.learned = vec!["detail".parse().expect("a stage")];
         let err = settings.engine.validate().expect_err("detail needs core").to_string();
         assert!(err.contains("engine.learned") && err.contains("core"), "{err}");
         let _ = std::fs::remove_dir_all(&models);
@@ -327,7 +327,11 @@ mod learned {
     fn a_coarse_model_of_the_wrong_resolution_is_refused_naming_its_manifest() {
         let models = models_dir("wrong", 1000.0);
         let settings = TerrainSettings {
-            engine: EngineSettings { learned: vec!["coarse".into()], models: models.clone(), ..Default::default() },
+            engine: EngineSettings {
+                learned: vec!["coarse".parse().expect("a stage")],
+                models: models.clone(),
+                ..Default::default()
+            },
             ..Default::default()
         };
         let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
@@ -339,7 +343,7 @@ mod learned {
     fn missing_weights_name_the_file_and_the_command_that_makes_them() {
         let empty = std::env::temp_dir().join(format!("infiniterra-no-models-{}", std::process::id()));
         let mut settings = TerrainSettings::default();
-        settings.engine.learned = vec!["core".into()];
+        settings.engine.learned = vec!["core".parse().expect("a stage")];
         settings.engine.models = empty;
         let err = Pipeline::build(1, &settings).err().expect("refused").to_string();
         assert!(err.contains("core.json") && err.contains("train core"), "{err}");

@@ -1,4 +1,5 @@
-//! NumPy `.npy` files for 2-D arrays: the format every analysis tool reads.
+//! NumPy `.npy` files for 2-D arrays: the format every analysis tool reads (`export` writes
+//! them; `eval` and `train` read and write them).
 //!
 //! Writes version 1.0, little-endian float32, C order, header padded so the data starts on a
 //! 64-byte boundary (what NumPy itself writes, so files can be memory-mapped). Reads float32

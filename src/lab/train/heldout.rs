@@ -13,11 +13,11 @@ use infiniterra_terrain::encoding::{box_downsample, signed_sqrt, signed_square};
 use infiniterra_terrain::infinite::{Engine, EngineConfig, Source, Windowed};
 use infiniterra_terrain::model::burn::tensor::Device;
 use infiniterra_terrain::model::stage::LearnedStage;
-use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel};
+use infiniterra_terrain::model::{ComputeBackend, LoadedModel};
 use infiniterra_terrain::tile::{Rect, Tile};
 
-use super::data::read_split;
-use crate::export::{read_npy_f32, write_npy_f32};
+use super::shipped::Shipped;
+use crate::npy::{read_npy_f32, write_npy_f32};
 
 /// A finite coarse grid extended by clamping, as a [`Source`].
 struct ClampedGrid {
@@ -67,8 +67,7 @@ pub fn compare(
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
-    let device = backend.device()?;
-    let model = load_model(models, stage, &device)?;
+    let Shipped { model, device, .. } = Shipped::load(models, stage, Path::new(""), backend)?;
     let ((rows, cols), metres) = read_npy_f32(real).map_err(anyhow::Error::msg)?;
     let n = rows;
     if rows != cols || n % model.manifest.window != 0 {
@@ -128,9 +127,9 @@ pub fn generate(
     seed: u64,
     backend: ComputeBackend,
 ) -> anyhow::Result<()> {
-    let device = backend.device()?;
-    let model = load_model(models, stage, &device)?;
-    let heldout = read_split(&data.join(stage), "heldout", 1, model.manifest.context).map_err(anyhow::Error::msg)?;
+    let shipped = Shipped::load(models, stage, data, backend)?;
+    let heldout = shipped.tiles("heldout")?;
+    let Shipped { model, device, .. } = shipped;
     let count = count.min(heldout.tiles.len());
     if draws == 0 {
         anyhow::bail!("--draws 0: at least one draw of each tile is needed");

@@ -6,7 +6,7 @@ use image::Rgb;
 
 use super::input::REGION_SQUARE_TILES;
 use super::measure::SetMetrics;
-use super::plot::{Panel, Series};
+use crate::draw::chart::{Panel, Series};
 use crate::terrain::metrics::{chi2_distance, histogram, quantile_edges, real_split_distances, wasserstein1};
 
 /// Quantile bins of the style histograms (fixed on the held-out reference).

@@ -1,9 +1,15 @@
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
+use infiniterra_terrain::model::burn;
+use infiniterra_terrain::model::{ComputeBackend, ModelManifest, NoiseDistribution, Precision, UNetConfig};
+
+use super::checkpoint::CheckpointState;
+use super::data::TileSet;
 use super::*;
 
-fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
-    TrainArgs {
+fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainOptions {
+    TrainOptions {
         stage: "core".into(),
         steps,
         resume,
@@ -39,11 +45,16 @@ fn smoke_args(out: &Path, steps: u64, resume: bool) -> TrainArgs {
     }
 }
 
-fn train(args: &TrainArgs) -> CheckpointState {
+fn train(args: &TrainOptions) -> CheckpointState {
     let spec = stage_spec("core", true).expect("core is trainable");
     let mut t = Trainer::new(args, 5, spec, data::synthetic(6, 128), data::synthetic(2, 128)).expect("trainer");
     t.run(&AtomicBool::new(false)).expect("training runs");
     t.state
+}
+
+/// A calibration of the smoke core in `dir` on 2 of the tiles in `data`.
+fn job<'a>(dir: &'a Path, data: &'a Path) -> shipped::Calibration<'a> {
+    shipped::Calibration { models: dir, stage: "core", data, tiles: 2, seed: 0, backend: ComputeBackend::Cpu }
 }
 
 fn tempdir(name: &str) -> PathBuf {
@@ -129,8 +140,8 @@ fn a_shipped_model_continues_training_from_its_weights_and_step() {
     let err = Trainer::new(&wrong, 0, spec, data::synthetic(2, 64), data::synthetic(1, 64))
         .err()
         .expect("a core model cannot continue as coarse");
-    assert_eq!(err.code, 2);
-    assert!(err.error.to_string().contains("core.json"), "{}", err.error);
+    assert!(matches!(err, TrainError::Input(_)), "{err}");
+    assert!(err.to_string().contains("core.json"), "{err}");
     let _ = std::fs::remove_dir_all(&first);
     let _ = std::fs::remove_dir_all(&continued);
 }
@@ -163,8 +174,8 @@ fn resuming_without_a_checkpoint_is_an_input_error() {
     let err = Trainer::new(&smoke_args(&dir, 4, true), 0, spec, data::synthetic(2, 64), data::synthetic(1, 64))
         .err()
         .expect("no checkpoint to resume");
-    assert_eq!(err.code, 2);
-    assert!(err.error.to_string().contains("state.json"), "{}", err.error);
+    assert!(matches!(err, TrainError::Input(_)), "{err}");
+    assert!(err.to_string().contains("state.json"), "{err}");
     assert!(stage_spec("canyon", false).is_err());
 }
 
@@ -175,11 +186,11 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
     let real = dir.join("region.npy");
     let tile = &data::synthetic(1, 64).tiles[0];
     let metres: Vec<f32> = tile.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h)).collect();
-    crate::export::write_npy_f32(&real, (64, 64), &metres).expect("write region");
+    crate::npy::write_npy_f32(&real, (64, 64), &metres).expect("write region");
     let png = dir.join("pictures/side.png");
     heldout::compare(&dir, "core", &real, &png, 3, ComputeBackend::Cpu).expect("counterpart");
     let ((rows, cols), generated) =
-        crate::export::read_npy_f32(&dir.join("region_generated.npy")).expect("generated region");
+        crate::npy::read_npy_f32(&dir.join("region_generated.npy")).expect("generated region");
     assert_eq!((rows, cols), (64, 64));
     assert!(generated.iter().all(|v| v.is_finite()));
     assert_ne!(generated, metres, "generated, not copied");
@@ -187,7 +198,7 @@ fn a_counterpart_keeps_the_real_region_s_shape_and_is_drawn_beside_it() {
     assert!(img.width() >= 3 * 64 && img.height() >= 64);
 
     // Not a square multiple of the window: refused, naming the file.
-    crate::export::write_npy_f32(&real, (64, 32), &metres[..64 * 32]).expect("write region");
+    crate::npy::write_npy_f32(&real, (64, 32), &metres[..64 * 32]).expect("write region");
     let err = heldout::compare(&dir, "core", &real, &png, 3, ComputeBackend::Cpu).expect_err("not square");
     assert!(err.to_string().contains("region.npy"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -204,8 +215,7 @@ fn smoke_core_with_training_tiles(name: &str, count: usize) -> (PathBuf, PathBuf
     let stack: Vec<f32> =
         tiles.tiles.iter().flat_map(|t| t.h.iter().map(|&h| infiniterra_terrain::encoding::signed_square(h))).collect();
     let train_npy = data_dir.join("core/train.npy");
-    crate::export::write_npy_f32(&train_npy, (count * data::PREPARED_TILE, data::PREPARED_TILE), &stack)
-        .expect("write");
+    crate::npy::write_npy_f32(&train_npy, (count * data::PREPARED_TILE, data::PREPARED_TILE), &stack).expect("write");
     (dir, data_dir, stack)
 }
 
@@ -214,7 +224,7 @@ fn calibrating_the_response_writes_ascending_knots_and_nothing_else() {
     let (dir, data_dir, _) = smoke_core_with_training_tiles("response", 2);
     let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
     let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
-    response::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+    response::run(&job(&dir, &data_dir)).expect("calibrates");
 
     let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
     let knots: Vec<[f64; 2]> =
@@ -242,7 +252,7 @@ fn calibrating_the_relief_hint_changes_only_its_offset() {
     let train_npy = data_dir.join("core/train.npy");
     let manifest_text = || std::fs::read_to_string(dir.join("core.json")).expect("manifest");
     let before: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
-    calibrate::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+    calibrate::run(&job(&dir, &data_dir)).expect("calibrates");
 
     let after: serde_json::Value = serde_json::from_str(&manifest_text()).expect("JSON");
     let offset = after["relief_hint"]["offset"].as_f64().expect("an offset was written");
@@ -259,9 +269,9 @@ fn calibrating_the_relief_hint_changes_only_its_offset() {
     );
 
     // Too few tiles: refused, naming the folder.
-    crate::export::write_npy_f32(&train_npy, (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack[..stack.len() / 2])
+    crate::npy::write_npy_f32(&train_npy, (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack[..stack.len() / 2])
         .expect("write");
-    let err = calibrate::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect_err("two tiles");
+    let err = calibrate::run(&job(&dir, &data_dir)).expect_err("two tiles");
     assert!(err.to_string().contains("at least 4"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -273,7 +283,7 @@ fn calibrating_the_spectrum_writes_a_loadable_equaliser_measured_without_the_old
         serde_json::from_str(&std::fs::read_to_string(dir.join("core.json")).expect("manifest")).expect("JSON")
     };
     let before = read();
-    spectrum::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+    spectrum::run(&job(&dir, &data_dir)).expect("calibrates");
     let first = read();
     let eq: infiniterra_terrain::model::SpectralEqualiser =
         serde_json::from_value(first["spectral_equaliser"].clone()).expect("an equaliser was written");
@@ -285,7 +295,7 @@ fn calibrating_the_spectrum_writes_a_loadable_equaliser_measured_without_the_old
     // The model still loads with it, and a second calibration measures the network itself,
     // not the network through the first equaliser: the same gains again.
     infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).expect("loads");
-    spectrum::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates again");
+    spectrum::run(&job(&dir, &data_dir)).expect("calibrates again");
     assert_eq!(read()["spectral_equaliser"], first["spectral_equaliser"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -297,7 +307,7 @@ fn calibrating_the_infill_writes_one_of_its_depth_scales_or_none_and_nothing_els
         serde_json::from_str(&std::fs::read_to_string(dir.join("core.json")).expect("manifest")).expect("JSON")
     };
     let before = read();
-    infill::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates");
+    infill::run(&job(&dir, &data_dir)).expect("calibrates");
     let first = read();
     if let Some(entry) = first.get("depression_infill") {
         let infill: infiniterra_terrain::model::DepressionInfill =
@@ -310,7 +320,7 @@ fn calibrating_the_infill_writes_one_of_its_depth_scales_or_none_and_nothing_els
     infiniterra_terrain::model::load_model(&dir, "core", &ComputeBackend::Cpu.device().expect("cpu")).expect("loads");
     // Every trial sets the infill itself, so the entry the first run wrote does not change
     // what a second run measures.
-    infill::run(&dir, "core", &data_dir, 2, 0, ComputeBackend::Cpu).expect("calibrates again");
+    infill::run(&job(&dir, &data_dir)).expect("calibrates again");
     assert_eq!(read(), first);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -319,13 +329,13 @@ fn calibrating_the_infill_writes_one_of_its_depth_scales_or_none_and_nothing_els
 fn held_out_draws_stack_draw_by_draw_and_draw_one_is_the_next_seed_block() {
     let (dir, data_dir, stack) = smoke_core_with_training_tiles("draws", 2);
     let heldout_npy = data_dir.join("core/heldout.npy");
-    crate::export::write_npy_f32(&heldout_npy, (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack).expect("write");
+    crate::npy::write_npy_f32(&heldout_npy, (2 * data::PREPARED_TILE, data::PREPARED_TILE), &stack).expect("write");
     let generate = |name: &str, draws: usize, seed: u64| {
         let out = dir.join(name);
         heldout::generate(&dir, "core", &data_dir, &out, 2, draws, seed, ComputeBackend::Cpu).expect("generates");
         let side: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).expect("sidecar")).expect("JSON");
-        (crate::export::read_npy_f32(&out).expect("npy"), side)
+        (crate::npy::read_npy_f32(&out).expect("npy"), side)
     };
     let (((rows, cols), two), side) = generate("two.npy", 2, 7);
     let n = data::PREPARED_TILE * data::PREPARED_TILE;

@@ -1,32 +1,34 @@
-//! Bitmap text in an `RgbImage` with the public-domain 8×8 font, scaled by whole pixels.
+//! Bitmap text with the public-domain 8×8 font, scaled by whole pixels.
 //!
-//! ASCII plus `°` and `×` (for units and sizes); anything else draws as `?` so a label never
-//! silently loses characters. Pixels outside the image are clipped, so long lines are cut at
-//! the edge instead of panicking.
+//! ASCII, Latin-1 (`°`, `²`, `×`, …) and Greek (`β`, `χ`, `Δ`); anything else draws as `?` so
+//! a label never silently loses characters. Pixels outside the image are clipped, so long
+//! lines are cut at the edge instead of panicking.
 
-use font8x8::legacy::{BASIC_LEGACY, LATIN_LEGACY};
+use font8x8::{UnicodeFonts, BASIC_FONTS, GREEK_FONTS, LATIN_FONTS};
 use image::{Rgb, RgbImage};
 
+use super::shapes::fill;
+
 /// Glyph cell size in font pixels (before scaling).
-pub(crate) const GLYPH: u32 = 8;
+pub const GLYPH: u32 = 8;
 
 /// The glyph of `ch`: one byte per row, bit 0 the leftmost pixel.
 fn glyph(ch: char) -> [u8; 8] {
-    match ch {
-        c if c.is_ascii() => BASIC_LEGACY[c as usize],
-        // LATIN_LEGACY covers U+00A0..=U+00FF.
-        '°' | '×' => LATIN_LEGACY[ch as usize - 0xA0],
-        _ => BASIC_LEGACY[b'?' as usize],
-    }
+    BASIC_FONTS
+        .get(ch)
+        .or_else(|| LATIN_FONTS.get(ch))
+        .or_else(|| GREEK_FONTS.get(ch))
+        .unwrap_or_else(|| BASIC_FONTS.get('?').unwrap_or([0; 8]))
 }
 
 /// Width in image pixels of `text` at `scale`.
-pub(crate) fn width(text: &str, scale: u32) -> u32 {
+pub fn width(text: &str, scale: u32) -> u32 {
     text.chars().count() as u32 * GLYPH * scale
 }
 
-/// Draws `text` with its top-left corner at (`x`, `y`); returns the x just past the text.
-pub(crate) fn draw(img: &mut RgbImage, x: i64, y: i64, text: &str, scale: u32, colour: Rgb<u8>) -> i64 {
+/// Draws `text` with its top-left corner at (`x`, `y`), each font pixel `scale`×`scale` image
+/// pixels; returns the x just past the text.
+pub fn text(img: &mut RgbImage, x: i64, y: i64, text: &str, scale: u32, colour: Rgb<u8>) -> i64 {
     let step = (GLYPH * scale) as i64;
     let mut cx = x;
     for ch in text.chars() {
@@ -43,16 +45,6 @@ pub(crate) fn draw(img: &mut RgbImage, x: i64, y: i64, text: &str, scale: u32, c
     cx
 }
 
-/// Fills a `w`×`h` rectangle at (`x`, `y`), clipped to the image.
-pub(crate) fn fill(img: &mut RgbImage, x: i64, y: i64, w: u32, h: u32, colour: Rgb<u8>) {
-    let (iw, ih) = (img.width() as i64, img.height() as i64);
-    for py in y.max(0)..(y + h as i64).min(ih) {
-        for px in x.max(0)..(x + w as i64).min(iw) {
-            img.put_pixel(px as u32, py as u32, colour);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -67,7 +59,7 @@ mod tests {
     #[test]
     fn text_is_drawn_inside_its_box() {
         let mut img = RgbImage::from_pixel(100, 40, WHITE);
-        let end = draw(&mut img, 10, 5, "Hi 42", 2, BLACK);
+        let end = text(&mut img, 10, 5, "Hi 42", 2, BLACK);
         assert_eq!(end, 10 + width("Hi 42", 2) as i64);
         let ink = inked(&img);
         assert!(ink.len() > 50, "only {} pixels inked", ink.len());
@@ -77,10 +69,24 @@ mod tests {
     }
 
     #[test]
+    fn ascii_degree_and_times_are_the_legacy_glyphs_and_greek_is_drawn() {
+        use font8x8::legacy::{BASIC_LEGACY, LATIN_LEGACY};
+        for c in 0u8..128 {
+            assert_eq!(glyph(c as char), BASIC_LEGACY[c as usize], "{c}");
+        }
+        for c in ['°', '×'] {
+            assert_eq!(glyph(c), LATIN_LEGACY[c as usize - 0xA0], "{c}");
+        }
+        for c in ['β', 'χ', 'Δ'] {
+            assert_ne!(glyph(c), glyph('?'), "{c}");
+        }
+    }
+
+    #[test]
     fn degree_sign_and_unknown_characters_draw_something() {
         for s in ["°", "×", "€"] {
             let mut img = RgbImage::from_pixel(8, 8, WHITE);
-            draw(&mut img, 0, 0, s, 1, BLACK);
+            text(&mut img, 0, 0, s, 1, BLACK);
             assert!(!inked(&img).is_empty(), "{s} drew nothing");
         }
     }
@@ -88,8 +94,8 @@ mod tests {
     #[test]
     fn drawing_off_the_edge_is_clipped() {
         let mut img = RgbImage::from_pixel(10, 10, WHITE);
-        draw(&mut img, -20, -3, "WWWWWW", 3, BLACK);
-        draw(&mut img, 5, 5, "W", 4, BLACK);
+        text(&mut img, -20, -3, "WWWWWW", 3, BLACK);
+        text(&mut img, 5, 5, "W", 4, BLACK);
         assert!(!inked(&img).is_empty());
     }
 }

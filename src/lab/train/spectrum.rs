@@ -9,18 +9,18 @@
 //! only how it is shared out over wavelengths), and again after `--calibrate-infill`: the
 //! infill follows the equaliser in each window, and what is measured is the final output.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::anyhow;
 use infiniterra_terrain::metrics::{fit_beta, radial_power_spectrum, Raster, Spectrum};
 use infiniterra_terrain::model::burn::tensor::Device;
 use infiniterra_terrain::model::equaliser::band_gain;
-use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel, SpectralEqualiser};
+use infiniterra_terrain::model::{LoadedModel, SpectralEqualiser};
 
 use super::calibrate::{raster as real_raster, spread};
-use super::data::{read_split, EncodedTile};
+use super::data::EncodedTile;
 use super::heldout::counterpart;
+use super::shipped::{Calibration, Shipped};
 
 /// Kernel radius, pixels: reaches the 32-pixel wavelengths the core falls short at (a
 /// quarter of the tile, the longest the realism bar's spectral fit uses) for 49² multiply-adds
@@ -81,25 +81,18 @@ fn ratios(real: &Spectrum, generated: &Spectrum, metres: f64) -> String {
         .join(", ")
 }
 
-/// Measures `<models>/<stage>.json` on `count` training tiles and writes its
+/// Measures `<models>/<stage>.json` on the job's training tiles and writes its
 /// `spectral_equaliser` into the manifest.
-pub fn run(
-    models: &Path,
-    stage: &str,
-    data: &Path,
-    count: usize,
-    seed: u64,
-    backend: ComputeBackend,
-) -> anyhow::Result<()> {
-    let device = backend.device()?;
-    let mut model = load_model(models, stage, &device)?;
-    let path = models.join(format!("{stage}.json"));
+pub fn run(job: &Calibration) -> anyhow::Result<()> {
+    let shipped = Shipped::for_calibration(job)?;
+    let train = shipped.tiles("train")?;
+    let Shipped { mut model, device, path, folder } = shipped;
+    let (stage, seed, count) = (job.stage, job.seed, job.tiles);
     model.manifest.spectral_equaliser = None;
-    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
     let metres = model.manifest.metres_per_pixel;
     let real: Vec<Spectrum> = tiles.iter().map(|t| radial_power_spectrum(&real_raster(t, metres))).collect();
-    let real = Spectrum::mean(&real).ok_or_else(|| anyhow!("{}: no training tiles of one size", data.display()))?;
+    let real = Spectrum::mean(&real).ok_or_else(|| anyhow!("{}: no training tiles of one size", folder.display()))?;
     let started = Instant::now();
     let before = generated_spectrum(&model, &device, &tiles, seed, "without an equaliser")
         .ok_or_else(|| anyhow!("no counterparts"))?;
@@ -112,7 +105,7 @@ pub fn run(
         ratios(&real, &before, metres)
     );
     let mut eq = SpectralEqualiser::from_spectra(&real, &before, metres, RADIUS, &KNOTS)
-        .ok_or_else(|| anyhow!("{}: tiles too small for the {}-pixel knots", data.display(), KNOTS[0]))?;
+        .ok_or_else(|| anyhow!("{}: tiles too small for the {}-pixel knots", folder.display(), KNOTS[0]))?;
     // The kernel's radius smooths the gain curve (by about a quarter octave at 32 pixels), so
     // one pass undershoots the narrow 16–32 km dip; a second pass multiplies in what is left.
     for pass in 1..=PASSES {
@@ -134,7 +127,7 @@ pub fn run(
     }
     let shown: Vec<String> = eq.gains.iter().map(|[l, g]| format!("{:.0} km ×{g:.2}", l * metres / 1000.0)).collect();
     println!("spectral equaliser of {}: radius {RADIUS} px, gains {}", path.display(), shown.join(", "));
-    crate::manifest_edit::edit_manifest(&path, |object| {
+    crate::lab::manifest_edit::edit_manifest(&path, |object| {
         object.insert("spectral_equaliser".into(), serde_json::to_value(&eq)?);
         Ok(())
     })

@@ -13,15 +13,15 @@
 //! drawn relief equal the real one — the knots of the hint's `response` curve. Minutes, not
 //! the hour a retraining takes; the weights are untouched.
 
-use std::path::Path;
 use std::time::Instant;
 
 use infiniterra_terrain::encoding::signed_sqrt;
-use infiniterra_terrain::model::{ComputeBackend, Normalisation, ReliefHint};
+use infiniterra_terrain::model::{Normalisation, ReliefHint};
 
 use super::calibrate::{load_hinted, spread, write_hint_fields, Hinted};
 use super::data::{crop_of, log_std, EncodedTile};
 use super::heldout::counterpart;
+use super::shipped::{Calibration, Shipped};
 
 /// Offsets the hint is raised by while probing (z units). The largest needs to reach past
 /// what the roughest windows need (≈ 2 for the first unblurred-context core).
@@ -94,17 +94,11 @@ fn crop_origins(size: usize, window: usize) -> impl Iterator<Item = (usize, usiz
     (0..n * n).map(move |i| ((i / n) * stride, (i % n) * stride))
 }
 
-/// Probes `<models>/<stage>.json` on `count` training tiles and writes the response curve
+/// Probes `<models>/<stage>.json` on the job's training tiles and writes the response curve
 /// (with the offset reset to 0) into the manifest.
-pub fn run(
-    models: &Path,
-    stage: &str,
-    data: &Path,
-    count: usize,
-    seed: u64,
-    backend: ComputeBackend,
-) -> anyhow::Result<()> {
-    let Hinted { mut model, device, path, hint, train } = load_hinted(models, stage, data, backend)?;
+pub fn run(job: &Calibration) -> anyhow::Result<()> {
+    let Hinted { shipped: Shipped { mut model, device, path, folder }, hint, train } = load_hinted(job)?;
+    let (stage, seed, count) = (job.stage, job.seed, job.tiles);
     let spec = model.manifest.context;
     let tiles = spread(&train.tiles, count.clamp(1, train.tiles.len().max(1)), 0.0);
     let (window, norm) = (model.manifest.window, model.manifest.normalisation.clone());
@@ -140,7 +134,7 @@ pub fn run(
     }
     let response = knots(&probes, &PROBE_OFFSETS);
     if response.is_empty() {
-        anyhow::bail!("{}: no windows to probe (tiles smaller than the {window}-pixel window?)", data.display());
+        anyhow::bail!("{}: no windows to probe (tiles smaller than the {window}-pixel window?)", folder.display());
     }
     let shown: Vec<String> = response.iter().map(|[x, e]| format!("{x:+.2} → {e:+.2}")).collect();
     println!("relief hint of {}: response (expected → extra) {}; offset reset to 0", path.display(), shown.join(", "));

@@ -11,15 +11,13 @@
 //! measures the windows' final output). Judged by an equaliser calibrated without it, any
 //! infill would look like a spectral error it is about to have corrected.
 
-use std::path::Path;
 use std::time::Instant;
 
-use anyhow::anyhow;
-use infiniterra_terrain::model::{load_model, ComputeBackend, DepressionInfill};
+use infiniterra_terrain::model::DepressionInfill;
 
 use super::calibrate::{best, score, BarSets, Trial};
-use super::data::read_split;
-use crate::eval::SPECTRAL_SLOPE_KEY;
+use super::shipped::{Calibration, Shipped};
+use crate::lab::eval::SPECTRAL_SLOPE_KEY;
 
 /// Depth scales tried after "off", metres, deepest first, halving: from about the depth of
 /// real closed basins 30–60 km across at 1 km (60 m on held-out land, 16–32 km ones 40 m)
@@ -32,21 +30,14 @@ fn label(depth: Option<f64>) -> String {
     depth.map_or("off".into(), |c| format!("{c} m"))
 }
 
-/// Measures `<models>/<stage>.json` on `count` training tiles for each depth scale and writes
+/// Measures `<models>/<stage>.json` on the job's training tiles for each depth scale and writes
 /// the best as its `depression_infill` (or removes it when "off" is best).
-pub fn run(
-    models: &Path,
-    stage: &str,
-    data: &Path,
-    count: usize,
-    seed: u64,
-    backend: ComputeBackend,
-) -> anyhow::Result<()> {
-    let device = backend.device()?;
-    let mut model = load_model(models, stage, &device)?;
-    let path = models.join(format!("{stage}.json"));
-    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
-    let sets = BarSets::new(&train, &data.join(stage), count, &model)?;
+pub fn run(job: &Calibration) -> anyhow::Result<()> {
+    let shipped = Shipped::for_calibration(job)?;
+    let train = shipped.tiles("train")?;
+    let Shipped { mut model, device, path, folder } = shipped;
+    let (stage, seed) = (job.stage, job.seed);
+    let sets = BarSets::new(&train, &folder, job.tiles, &model)?;
     let count = sets.tiles.len();
 
     let started = Instant::now();
@@ -94,7 +85,7 @@ pub fn run(
         chosen.score,
         summary.join("; ")
     );
-    crate::manifest_edit::edit_manifest(&path, |object| {
+    crate::lab::manifest_edit::edit_manifest(&path, |object| {
         match depth {
             Some(c) => {
                 object.insert("depression_infill".into(), serde_json::to_value(DepressionInfill { depth_scale_m: c })?)

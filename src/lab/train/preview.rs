@@ -80,7 +80,7 @@ pub fn side_by_side(path: &Path, title: &str, panels: &[&[f32]], side: usize) ->
     let top = 28;
     let (w, h) = (panels.len() * side + (panels.len() + 1) * GAP, top + side + GAP);
     let mut img = image::RgbImage::from_pixel(w as u32, h as u32, image::Rgb([255, 255, 255]));
-    crate::eval::plot::text(&mut img, GAP as i64, 8, title, image::Rgb([0, 0, 0]));
+    crate::draw::text(&mut img, GAP as i64, 8, title, 1, image::Rgb([0, 0, 0]));
     let (lo, hi) = panels[0].iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
     for (c, p) in panels.iter().enumerate() {
         draw(&mut img, p, side, GAP + c * (side + GAP), top, lo, hi, 1);

@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use super::EvalError;
-use crate::export::{read_npy_f32, ExportMeta, Grid};
+use crate::export::{ExportMeta, Grid};
+use crate::npy::read_npy_f32;
 use crate::terrain::metrics::Raster;
 use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
 

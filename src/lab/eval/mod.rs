@@ -5,20 +5,16 @@
 //! Owns: loading heightmaps and prepared sets, the baselines (fBm matched in amplitude,
 //! real-vs-real), the realism table and the report image. The metric math lives in
 //! `infiniterra_terrain::metrics`. Must not touch: the pipeline (generated terrain comes in
-//! as an exported `.npy`), the command line's parsing beyond [`EvalArgs`] and [`DataArgs`].
+//! as an exported `.npy`), the command line's parsing beyond [`EvalOptions`].
 
-pub mod data;
 mod input;
 mod measure;
-pub(crate) mod plot;
 mod report;
 
 use std::path::{Path, PathBuf};
 
-use clap::Args;
 use image::Rgb;
 
-pub use data::DataArgs;
 pub use input::{Heightmap, Reference};
 pub use report::{BetaSplits, Report, Target, SPECTRAL_SLOPE_KEY};
 
@@ -29,27 +25,22 @@ use report::Column;
 /// Seed of the fBm baseline: fixed, so every report compares against the same noise.
 pub const FBM_SEED: u64 = 0x1FB3_5EED;
 
-/// Arguments of `infiniterra eval`.
-#[derive(Debug, Args)]
-pub struct EvalArgs {
+/// What `infiniterra eval` compares and where it writes.
+#[derive(Debug, Clone)]
+pub struct EvalOptions {
     /// Generated heightmap: float32 `.npy` with its JSON sidecar (e.g. from
     /// `infiniterra export --grid model`).
-    #[arg(long)]
     pub generated: PathBuf,
     /// Reference: a prepared set directory (e.g. `data/prepared/core`: held-out split is the
     /// reference, training split the real-vs-real baseline) or one `.npy` with its sidecar.
-    #[arg(long)]
     pub reference: PathBuf,
     /// Report image (slope histograms and power spectra).
-    #[arg(long, default_value = "eval_report.png")]
     pub out: PathBuf,
     /// Window stride of the generator in model pixels: seams are measured on lines this far
     /// apart (32 = the pipeline's window stride).
-    #[arg(long, default_value_t = 32)]
     pub seam_stride: usize,
     /// Model manifest (e.g. `models/core.json`) whose `realism` numbers are replaced by this
     /// report's generated values and realism bar (needs a reference with a train split).
-    #[arg(long)]
     pub record: Option<PathBuf>,
 }
 
@@ -104,7 +95,7 @@ pub fn realism_bar(reference: &[Raster], generated: &[Raster], floor: &[Raster],
 
 /// Runs the evaluation: measures generated, fBm, reference and (for a prepared set) training
 /// tiles, writes the image to `args.out` and returns the table. `progress(done, total)` counts tiles.
-pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report, EvalError> {
+pub fn run(args: &EvalOptions, progress: &mut dyn FnMut(u64, u64)) -> Result<Report, EvalError> {
     if args.seam_stride < 2 {
         return Err(EvalError::Input(format!("--seam-stride {} is too small (at least 2)", args.seam_stride)));
     }
@@ -155,7 +146,7 @@ pub fn run(args: &EvalArgs, progress: &mut dyn FnMut(u64, u64)) -> Result<Report
     let table = Report::new(notes, &columns, &caption, regions.as_deref());
     let mut panels = vec![report::slope_panel(&columns), report::spectrum_panel(&columns)];
     panels.extend(table.beta_splits.as_ref().map(report::beta_split_panel));
-    let image = plot::draw(&table.notes, &panels);
+    let image = crate::draw::chart::draw(&table.notes, &panels);
     save(&image, &args.out)?;
     if let Some(manifest) = &args.record {
         record(manifest, &table)?;
@@ -187,7 +178,7 @@ fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
         realism.insert("real_split_within_spectral_line".into(), serde_json::json!(b.within_line));
         realism.insert("real_split_farther_than_generated".into(), serde_json::json!(b.farther_than_generated));
     }
-    crate::manifest_edit::edit_manifest(path, |object| {
+    crate::lab::manifest_edit::edit_manifest(path, |object| {
         object.insert("realism".into(), serde_json::Value::Object(realism));
         Ok(())
     })
@@ -211,7 +202,7 @@ fn native_seams(generated: &Heightmap, stride_model_px: usize) -> crate::terrain
 }
 
 fn notes(
-    args: &EvalArgs,
+    args: &EvalOptions,
     reference: &Reference,
     generated: &Heightmap,
     gen_tiles: usize,

@@ -12,7 +12,7 @@ use infiniterra_terrain::encoding::{signed_sqrt, ContextSpec};
 use infiniterra_terrain::model::hint::{features, FEATURES};
 use infiniterra_terrain::model::{sha256_file, DataChecksum, HostRng, NoiseDistribution, Normalisation, ReliefHint};
 
-use crate::export::read_npy_f32;
+use crate::npy::read_npy_f32;
 
 /// Side of every prepared tile (`data prepare` writes stacks of them).
 pub const PREPARED_TILE: usize = 256;

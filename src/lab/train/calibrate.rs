@@ -9,17 +9,18 @@
 //! for a grid of offsets, each set is scored against those tiles with the bar's own yardsticks,
 //! and the best offset is written into the manifest. The weights are untouched.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::anyhow;
 use infiniterra_terrain::encoding::signed_square;
 use infiniterra_terrain::model::burn::tensor::Device;
-use infiniterra_terrain::model::{load_model, ComputeBackend, LoadedModel, ReliefHint};
+use infiniterra_terrain::model::{LoadedModel, ReliefHint};
 
-use super::data::{read_split, EncodedTile, TileSet};
+use super::data::{EncodedTile, TileSet};
 use super::heldout::counterpart;
-use crate::eval::{realism_bar, Target};
+use super::shipped::{Calibration, Shipped};
+use crate::lab::eval::{realism_bar, Target};
 use crate::terrain::metrics::Raster;
 
 /// Offsets tried first (z units): 0, 0.2, … up to [`GRID_MAX`], until two in a row fall
@@ -138,41 +139,39 @@ impl<'a> BarSets<'a> {
     }
 }
 
-/// What both calibrations start from: the shipped model, its device, manifest path, relief
-/// hint, and the stage's training tiles (from `data`) encoded with its context.
+/// What the hint calibrations start from: the shipped model with its post-processing off, its
+/// relief hint, and the stage's training tiles.
 pub(super) struct Hinted {
-    pub model: LoadedModel,
-    pub device: Device,
-    pub path: PathBuf,
+    pub shipped: Shipped,
     pub hint: ReliefHint,
     pub train: TileSet,
 }
 
-/// Loads `<models>/<stage>.json` with its weights on `backend` and the stage's training tiles;
-/// an error naming the command that fits a hint when the model has none.
-pub(super) fn load_hinted(models: &Path, stage: &str, data: &Path, backend: ComputeBackend) -> anyhow::Result<Hinted> {
-    let device = backend.device()?;
-    let mut model = load_model(models, stage, &device)?;
+/// Loads the job's model and training tiles; an error naming the command that fits a hint
+/// when the model has none.
+pub(super) fn load_hinted(job: &Calibration) -> anyhow::Result<Hinted> {
+    let mut shipped = Shipped::for_calibration(job)?;
+    let manifest = &mut shipped.model.manifest;
     // Both calibrations measure the network's own answer: the steps after it in each window
     // (context projection, equaliser, infill) are calibrated on it afterwards.
-    model.manifest.context_projection = None;
-    model.manifest.spectral_equaliser = None;
-    model.manifest.depression_infill = None;
-    let path = models.join(format!("{stage}.json"));
-    let Some(hint) = model.manifest.relief_hint.clone() else {
+    manifest.context_projection = None;
+    manifest.spectral_equaliser = None;
+    manifest.depression_infill = None;
+    let Some(hint) = manifest.relief_hint.clone() else {
         anyhow::bail!(
-            "{} has no relief hint to calibrate: run `infiniterra train {stage} --fit-relief-hint` first",
-            path.display()
+            "{} has no relief hint to calibrate: run `infiniterra train {} --fit-relief-hint` first",
+            shipped.path.display(),
+            job.stage
         );
     };
-    let train = read_split(&data.join(stage), "train", 1, model.manifest.context).map_err(|e| anyhow!(e))?;
-    Ok(Hinted { model, device, path, hint, train })
+    let train = shipped.tiles("train")?;
+    Ok(Hinted { shipped, hint, train })
 }
 
 /// Writes `fields` into the `relief_hint` object of the manifest at `path`, leaving the rest
 /// of the file as it was.
 pub(super) fn write_hint_fields(path: &Path, fields: Vec<(&str, serde_json::Value)>) -> anyhow::Result<()> {
-    crate::manifest_edit::edit_manifest(path, |object| {
+    crate::lab::manifest_edit::edit_manifest(path, |object| {
         let hint = object
             .get_mut("relief_hint")
             .and_then(|h| h.as_object_mut())
@@ -184,18 +183,12 @@ pub(super) fn write_hint_fields(path: &Path, fields: Vec<(&str, serde_json::Valu
     })
 }
 
-/// Runs the calibration for `<models>/<stage>.json` on `count` training tiles and writes the
+/// Runs the calibration for `<models>/<stage>.json` on the job's training tiles and writes the
 /// chosen `relief_hint.offset` into the manifest.
-pub fn run(
-    models: &Path,
-    stage: &str,
-    data: &Path,
-    count: usize,
-    seed: u64,
-    backend: ComputeBackend,
-) -> anyhow::Result<()> {
-    let Hinted { mut model, device, path, train, .. } = load_hinted(models, stage, data, backend)?;
-    let sets = BarSets::new(&train, &data.join(stage), count, &model)?;
+pub fn run(job: &Calibration) -> anyhow::Result<()> {
+    let Hinted { shipped: Shipped { mut model, device, path, folder }, train, .. } = load_hinted(job)?;
+    let (stage, seed) = (job.stage, job.seed);
+    let sets = BarSets::new(&train, &folder, job.tiles, &model)?;
     let count = sets.tiles.len();
 
     let started = Instant::now();

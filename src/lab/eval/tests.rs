@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::*;
-use crate::export::write_npy_f32;
+use crate::npy::write_npy_f32;
 
 /// Terrain-like values: positive fBm relief (no sea) so every metric has something to see.
 fn hills(rows: usize, cols: usize, metres: f64, seed: u64) -> Raster {
@@ -40,8 +40,8 @@ fn write_generated(path: &Path, side: usize) {
     std::fs::write(path.with_extension("json"), meta.to_string()).unwrap();
 }
 
-fn args(generated: &Path, reference: &Path, out: &Path) -> EvalArgs {
-    EvalArgs {
+fn args(generated: &Path, reference: &Path, out: &Path) -> EvalOptions {
+    EvalOptions {
         generated: generated.into(),
         reference: reference.into(),
         out: out.into(),
@@ -111,7 +111,7 @@ fn counterparts_of_the_first_heldout_tiles_are_compared_with_those_tiles_only() 
     let set = prepared_set(dir.path(), 3);
     // The first held-out tile itself, as `train core --generate-heldout --tiles 1` labels it.
     let first = dir.path().join("first.npy");
-    let (_, heldout) = crate::export::read_npy_f32(&set.join("heldout.npy")).unwrap();
+    let (_, heldout) = crate::npy::read_npy_f32(&set.join("heldout.npy")).unwrap();
     write_npy_f32(&first, (64, 64), &heldout[..64 * 64]).unwrap();
     let side = serde_json::json!({"metres_per_pixel": 1000.0, "tile": 64, "count": 1, "heldout_counterparts": 1});
     std::fs::write(first.with_extension("json"), side.to_string()).unwrap();

@@ -11,25 +11,20 @@ mod engine;
 mod pipeline;
 mod pregen;
 
-use clap::Args;
 use serde::Serialize;
 
 use crate::config::Config;
 
-/// Arguments of `infiniterra bench`.
-#[derive(Debug, Args)]
-pub struct BenchArgs {
+/// What `infiniterra bench` measures and where it writes.
+#[derive(Debug, Clone)]
+pub struct BenchOptions {
     /// Print JSON instead of a table.
-    #[arg(long)]
     pub json: bool,
     /// Runs per measurement (the median is reported).
-    #[arg(long, default_value_t = 3)]
     pub runs: usize,
     /// Chunks in the long pre-generation run (throughput and peak memory); 0 skips it.
-    #[arg(long, default_value_t = 20_000)]
     pub pregen_chunks: u64,
     /// Where to write the chart.
-    #[arg(long, default_value = "bench.png")]
     pub out: std::path::PathBuf,
 }
 
@@ -58,7 +53,7 @@ impl Measurement {
 }
 
 /// Runs the suite and prints it.
-pub fn run(config: &Config, args: &BenchArgs) -> anyhow::Result<()> {
+pub fn run(config: &Config, args: &BenchOptions) -> anyhow::Result<()> {
     let runs = args.runs.max(1);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut all = engine::measure(runs);
