@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 /// E[silu(x)²]^½ for x ~ N(0, 1): dividing by it keeps unit magnitude (EDM2's constant).
 /// Defined here, at the bottom of the model's layers, because both this kernel's fused SiLU
-/// and the layers' [`mp_silu`](super::layers::mp_silu) divide by it.
+/// and the layers' `mp_silu` divide by it.
 pub(super) const SILU_MAGNITUDE: f32 = 0.596;
 
 /// Output positions (in the padded row stride) per GEMM: the band's right-hand side,
