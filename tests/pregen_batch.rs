@@ -14,7 +14,7 @@ use infiniterra::biome::BiomeRules;
 use infiniterra::config::Config;
 use infiniterra::fill::{BiomePalette, Generator};
 use infiniterra::pregen::{Plan, Progress, Shape, Shard, State, Task};
-use infiniterra::server::find_spawn;
+use infiniterra::world::find_spawn;
 use infiniterra::terrain::Pipeline;
 use infiniterra::world::region::{RegionFile, RegionPos};
 use serde_json::Value;

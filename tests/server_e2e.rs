@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use infiniterra::biome::BiomeRules;
 use infiniterra::config::Config;
 use infiniterra::fill::Generator;
-use infiniterra::server::find_spawn;
+use infiniterra::world::find_spawn;
 use infiniterra::terrain::Pipeline;
 use serde_json::Value;
 use valence::prelude::{BlockState, ChunkPos, ChunkView};

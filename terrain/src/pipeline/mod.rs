@@ -15,6 +15,7 @@ use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
+use crate::model_files::ModelFiles;
 use crate::settings::TerrainSettings;
 use crate::tile::{Rect, Tile};
 use crate::upsample;
@@ -141,6 +142,16 @@ impl Pipeline {
     /// Builds the pipeline of `seed` with validated `settings`, loading the learned stages
     /// they name (`engine.learned`) from `engine.models` on `engine.backend`.
     pub fn build(seed: u64, settings: &TerrainSettings) -> Result<Pipeline, PipelineError> {
+        Pipeline::build_with_models(seed, settings, &ModelFiles::Dir(settings.engine.models.clone()))
+    }
+
+    /// [`Pipeline::build`], reading the learned stages from `models` (a folder, or the models
+    /// built into the binary) instead of `engine.models`.
+    pub fn build_with_models(
+        seed: u64,
+        settings: &TerrainSettings,
+        models: &ModelFiles,
+    ) -> Result<Pipeline, PipelineError> {
         let engine = Engine::new(EngineConfig {
             cache_bytes: (settings.engine.cache_mib as usize) << 20,
             threads: settings.engine.threads as usize,
@@ -152,7 +163,8 @@ impl Pipeline {
         let learned = |name: &str| settings.engine.learned.iter().any(|s| s == name);
         let coarse_elevation: Arc<dyn Source> = if learned("coarse") {
             // The coarse model refines the layout's sketch on the sketch's own 8 km grid.
-            let stage = learned_stage("coarse", seed, settings, &engine, sketch_elevation, coarse_metres, &mut stages)?;
+            let stage =
+                learned_stage("coarse", seed, settings, models, &engine, sketch_elevation, coarse_metres, &mut stages)?;
             stage.on_grid(coarse_metres)?
         } else {
             sketch_elevation
@@ -171,12 +183,20 @@ impl Pipeline {
             },
         );
         let elevation: Arc<dyn Source> = if learned("core") {
-            let core =
-                learned_stage("core", seed, settings, &engine, coarse_elevation.clone(), coarse_metres, &mut stages)?;
+            let core = learned_stage(
+                "core",
+                seed,
+                settings,
+                models,
+                &engine,
+                coarse_elevation.clone(),
+                coarse_metres,
+                &mut stages,
+            )?;
             if learned("detail") {
                 // The detail model adds the high-frequency residual over the core's own grid.
                 let (context, metres) = (core.source, core.metres);
-                learned_stage("detail", seed, settings, &engine, context, metres, &mut stages)?
+                learned_stage("detail", seed, settings, models, &engine, context, metres, &mut stages)?
                     .on_grid(MODEL_PIXEL_METRES)?
             } else {
                 core.on_grid(MODEL_PIXEL_METRES)?
@@ -337,20 +357,22 @@ impl StageGrid {
 /// of `context_metres`; box-averaged further when the model's context, `context.factor` of
 /// its own pixels, is coarser than that). Marks the stage active.
 #[cfg(feature = "learned")]
+#[allow(clippy::too_many_arguments)] // The stage's whole context; one call site per stage.
 fn learned_stage(
     name: &str,
     seed: u64,
     settings: &TerrainSettings,
+    models: &ModelFiles,
     engine: &Arc<Engine>,
     context: Arc<dyn Source>,
     context_metres: f64,
     stages: &mut [StageStatus],
 ) -> Result<StageGrid, PipelineError> {
-    use crate::model::{load_model, stage::LearnedStage, ComputeBackend};
+    use crate::model::{load_model_from, stage::LearnedStage, ComputeBackend};
     let backend: ComputeBackend = settings.engine.backend.parse()?;
     let device = backend.device()?;
-    let model = load_model(&settings.engine.models, name, &device)?;
-    let file = settings.engine.models.join(format!("{name}.json")).display().to_string();
+    let model = load_model_from(models, name, &device)?;
+    let file = models.shown(std::path::Path::new(&format!("{name}.json"))).display().to_string();
     let metres = model.manifest.metres_per_pixel;
     let cell = metres * model.manifest.context.factor as f64;
     let ratio = cell / context_metres;
@@ -376,10 +398,12 @@ fn learned_stage(
 }
 
 #[cfg(not(feature = "learned"))]
+#[allow(clippy::too_many_arguments)]
 fn learned_stage(
     _name: &str,
     _seed: u64,
     settings: &TerrainSettings,
+    _models: &ModelFiles,
     _engine: &Arc<Engine>,
     _context: Arc<dyn Source>,
     _context_metres: f64,
