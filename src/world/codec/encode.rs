@@ -4,7 +4,7 @@
 use valence::prelude::{BiomeId, BlockState, Chunk, UnloadedChunk};
 use valence::registry::RegistryIdx;
 
-use super::nbt::{bit_width, packed_len, tag, Writer};
+use super::nbt::{bit_width, tag, Writer};
 use super::{BLOCKS, CELLS, DATA_VERSION};
 use crate::fill::SkyLight;
 
