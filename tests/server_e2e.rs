@@ -14,8 +14,8 @@ use std::time::{Duration, Instant};
 use infiniterra::biome::BiomeRules;
 use infiniterra::config::Config;
 use infiniterra::fill::Generator;
-use infiniterra::world::find_spawn;
 use infiniterra::terrain::Pipeline;
+use infiniterra::world::find_spawn;
 use serde_json::Value;
 use valence::prelude::{BlockState, ChunkPos, ChunkView};
 
