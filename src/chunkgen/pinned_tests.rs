@@ -152,7 +152,7 @@ fn the_procedural_world_is_the_recorded_one() {
 #[test]
 fn the_world_of_the_shipped_core_is_the_recorded_one() {
     let mut config = Config::default();
-    config.engine.learned = vec!["core".to_string()];
+    config.engine.learned = vec!["core".parse().expect("a learned stage")];
     config.engine.models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
     let pipeline = Pipeline::build(config.world.seed, &config.terrain()).expect("the shipped core loads");
     let g = Generator::new(Arc::new(pipeline), &config);

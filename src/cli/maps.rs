@@ -5,12 +5,12 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::progress::Progress;
-use super::{Failure, Size};
-use crate::biome::BiomeRules;
+use super::{world_sources, Failure, Size, Sources};
 use crate::config::Config;
 use crate::export::{self, ExportRequest, Grid, Vertical};
 use crate::chunkgen::Generator;
 use crate::render::{self, Layer, RenderRequest};
+use crate::terrain::model_files::ModelFiles;
 use crate::terrain::Pipeline;
 
 /// A rectangle of the world in block coordinates (x east, z south).
@@ -42,9 +42,10 @@ pub struct RenderArgs {
     /// Output PNG.
     #[arg(long)]
     pub out: PathBuf,
-    /// Folder of biome rules (for `--layer biome`).
-    #[arg(long, default_value = "biomes")]
-    pub biomes: PathBuf,
+    /// Folder of biome rules (for `--layer biome`; default: `biomes/` here if it exists,
+    /// else the built-in rules).
+    #[arg(long)]
+    pub biomes: Option<PathBuf>,
 }
 
 /// Arguments of `infiniterra export`.
@@ -70,12 +71,13 @@ fn classify<E: std::error::Error + Send + Sync + 'static>(bad_input: bool, e: E)
     }
 }
 
-fn pipeline(config: &Config) -> Result<Pipeline, Failure> {
-    Pipeline::build(config.world.seed, &config.terrain()).map_err(Failure::input)
+fn pipeline(config: &Config, models: &ModelFiles) -> Result<Pipeline, Failure> {
+    Pipeline::build_with_models(config.world.seed, &config.terrain(), models).map_err(Failure::input)
 }
 
 /// Runs `render`.
-pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
+pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), Failure> {
+    let (rules, models) = world_sources(config, sources, a.biomes.as_deref());
     if a.zoom < 1 {
         return Err(Failure::input(anyhow::anyhow!("--zoom {} is out of range (allowed 1 or more)", a.zoom)));
     }
@@ -89,11 +91,11 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
     };
     let mut progress = Progress::new("render", "rows");
     let image = if a.layer == Layer::Biome {
-        let rules = BiomeRules::load_dir(&a.biomes).map_err(Failure::input)?;
-        let generator = Generator::new(std::sync::Arc::new(pipeline(config)?), config);
+        let rules = rules.load().map_err(Failure::input)?;
+        let generator = Generator::new(std::sync::Arc::new(pipeline(config, &models)?), config);
         render::render_biomes(&generator, &rules, &req, &mut |d, t| progress.update(d, t))
     } else {
-        render::render(&pipeline(config)?, &req, &mut |d, t| progress.update(d, t))
+        render::render(&pipeline(config, &models)?, &req, &mut |d, t| progress.update(d, t))
     }
     .map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
@@ -103,7 +105,7 @@ pub fn render(config: &Config, a: &RenderArgs) -> Result<(), Failure> {
 }
 
 /// Runs `export`.
-pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
+pub fn export(config: &Config, sources: &Sources, a: &ExportArgs) -> Result<(), Failure> {
     let req = ExportRequest {
         x0: a.area.x0,
         z0: a.area.z0,
@@ -113,7 +115,8 @@ pub fn export(config: &Config, a: &ExportArgs) -> Result<(), Failure> {
     };
     let vertical =
         Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
-    let pipeline = pipeline(config)?;
+    let (_, models) = world_sources(config, sources, None);
+    let pipeline = pipeline(config, &models)?;
     let mut progress = Progress::new("export", "rows");
     let summary = export::export(&pipeline, &req, &vertical, &a.out, &mut |d, t| progress.update(d, t))
         .map_err(|e| classify(e.is_bad_input(), e))?;

@@ -5,24 +5,35 @@
 mod args;
 mod lab;
 mod maps;
+mod pregen;
 mod progress;
+mod serve;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::config::{Config, DEFAULT_PATH};
+use crate::config::{shipped, Config, ConfigOrigin};
+use crate::terrain::model_files::ModelFiles;
+use crate::world::RulesSource;
 
 pub use args::Size;
+pub use pregen::PregenArgs;
+pub use serve::ServeArgs;
 
 /// infiniterra: a Minecraft world generator with learned, infinite, seed-consistent terrain.
 #[derive(Debug, Parser)]
 #[command(name = "infiniterra", version, about, propagate_version = true)]
 pub struct Cli {
-    /// Configuration file.
-    #[arg(long, global = true, default_value = DEFAULT_PATH)]
-    pub config: PathBuf,
+    /// Configuration file (default: `config/server.toml` here, else
+    /// `~/.config/infiniterra/server.toml`, else the built-in configuration).
+    #[arg(long, global = true)]
+    pub config: Option<PathBuf>,
+    /// Folder of the learned stages' models (default: `[engine] models` if it holds them, else
+    /// the models built into the binary).
+    #[arg(long, global = true)]
+    pub models: Option<PathBuf>,
     /// World seed (overrides `[world] seed`).
     #[arg(long, global = true)]
     pub seed: Option<u64>,
@@ -35,11 +46,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Run the Minecraft server (Java Edition 1.20.1).
-    Serve {
-        /// Folder of biome rule files (`*.toml`); the console's `reload` re-reads it.
-        #[arg(long, default_value = "biomes")]
-        biomes: PathBuf,
-    },
+    Serve(serve::ServeArgs),
     /// Draw a map of any rectangle of the world as a PNG.
     Render(maps::RenderArgs),
     /// Write raw elevation (float32 metres, .npy) of a rectangle, with a JSON sidecar.
@@ -59,7 +66,7 @@ pub enum Command {
         rest: Vec<String>,
     },
     /// Pre-generate a region into Anvil files without a server (resumable; shardable).
-    Pregen(crate::pregen::batch::PregenArgs),
+    Pregen(pregen::PregenArgs),
     /// Measure the engine and the pipeline on this machine.
     Bench(lab::BenchArgs),
 }
@@ -97,27 +104,72 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// Loads the configuration named on the command line, applying `--seed`.
-pub fn load_config(cli: &Cli) -> Result<Config, Failure> {
-    let mut config = Config::load(&cli.config).map_err(Failure::input)?;
+/// Where this run's configuration came from (the models and rules are settled per command).
+#[derive(Clone, Debug)]
+pub struct Sources {
+    /// The configuration file, or the built-in one.
+    pub config: ConfigOrigin,
+    /// `--models`, if given.
+    pub models: Option<PathBuf>,
+}
+
+/// Loads the configuration the command line names (or finds it), applying `--seed` and
+/// `--models`.
+pub fn load_config(cli: &Cli) -> Result<(Config, Sources), Failure> {
+    let (mut config, origin) = Config::find(cli.config.as_deref()).map_err(Failure::input)?;
     if let Some(seed) = cli.seed {
         config.world.seed = seed;
     }
-    Ok(config)
+    if let Some(models) = &cli.models {
+        // Tools that read `engine.models` themselves (bench, eval) see `--models` too.
+        config.engine.models = models.clone();
+    }
+    Ok((config, Sources { config: origin, models: cli.models.clone() }))
+}
+
+/// The models and biome rules a product command uses: `--models` / `--biomes` when given;
+/// else the configured models folder, or `biomes/` here, when they exist; else the copies
+/// built into the binary. An owner who points `[engine] models` elsewhere gets that folder
+/// or an error naming it, never a silent substitute.
+fn world_sources(config: &Config, sources: &Sources, biomes: Option<&Path>) -> (RulesSource, ModelFiles) {
+    let rules = match biomes {
+        Some(dir) => RulesSource::Dir(dir.to_path_buf()),
+        None if Path::new("biomes").is_dir() => RulesSource::Dir(PathBuf::from("biomes")),
+        None => RulesSource::BuiltIn,
+    };
+    let dir = ModelFiles::Dir(config.engine.models.clone());
+    let default_dir = config.engine.models == crate::terrain::settings::EngineSettings::default().models;
+    let holds_manifests = config.engine.learned.iter().all(|stage| dir.has(Path::new(&format!("{stage}.json"))));
+    let models = if sources.models.is_some() || !default_dir || holds_manifests { dir } else { shipped::models() };
+    (rules, models)
+}
+
+/// Tells the owner which configuration, models and biome rules this run uses.
+fn tell_sources(sources: &Sources, rules: &RulesSource, models: &ModelFiles, config: &Config) {
+    println!("config: {}", sources.config);
+    if config.engine.learned.is_empty() {
+        println!("models: none needed (engine.learned = [])");
+    } else {
+        println!("models: {models}");
+    }
+    println!("biomes: {rules}");
 }
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), Failure> {
     match &cli.command {
-        Command::Serve { biomes } => {
-            let options = crate::server::ServeOptions { biomes_dir: biomes.clone() };
-            crate::server::serve(&load_config(&cli)?, &options).map_err(|e| match e {
-                crate::server::ServeError::Input(e) => Failure::input(e),
-                crate::server::ServeError::Runtime(e) => Failure::runtime(e),
-            })
+        Command::Serve(a) => {
+            let (config, sources) = load_config(&cli)?;
+            serve::run(&config, &sources, a)
         }
-        Command::Render(a) => maps::render(&load_config(&cli)?, a),
-        Command::Export(a) => maps::export(&load_config(&cli)?, a),
+        Command::Render(a) => {
+            let (config, sources) = load_config(&cli)?;
+            maps::render(&config, &sources, a)
+        }
+        Command::Export(a) => {
+            let (config, sources) = load_config(&cli)?;
+            maps::export(&config, &sources, a)
+        }
         Command::Data(a) => crate::lab::data::run(&a.into()).map_err(Failure::runtime),
         Command::Eval(a) => {
             let mut progress = progress::Progress::new("eval", "tiles");
@@ -142,7 +194,10 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             "this binary was built without the learned-model code (--no-default-features): \
              build with the default features (`cargo run --release -- train STAGE`)"
         ))),
-        Command::Pregen(a) => crate::pregen::batch::run(&load_config(&cli)?, a),
-        Command::Bench(a) => crate::lab::bench::run(&load_config(&cli)?, &a.into()).map_err(Failure::runtime),
+        Command::Pregen(a) => {
+            let (config, sources) = load_config(&cli)?;
+            pregen::run(&config, &sources, a)
+        }
+        Command::Bench(a) => crate::lab::bench::run(&load_config(&cli)?.0, &a.into()).map_err(Failure::runtime),
     }
 }

@@ -4,7 +4,10 @@
 //! a message naming the file, the line, the key and what is allowed; unknown keys are errors
 //! too (a typo must not silently fall back to a default).
 
+mod find;
+mod gamemode;
 mod locate;
+pub mod shipped;
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
@@ -14,19 +17,23 @@ use serde::Deserialize;
 use crate::terrain::settings::{check_range, EngineSettings, RangeError, TerrainSettings};
 use crate::terrain::{climate::ClimateSettings, layout::LayoutSettings};
 
-/// Where the configuration lives unless `--config` says otherwise.
+pub use find::{platform_path, ConfigOrigin};
+pub use gamemode::GameMode;
+
+/// Where the configuration is looked for first (under the current directory) unless
+/// `--config` names a file.
 pub const DEFAULT_PATH: &str = "config/server.toml";
 
 /// A configuration that cannot be used, with where and why.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// The file could not be read.
-    #[error("{file}: cannot read: {source}")]
+    #[error("{file}: cannot read the configuration file: {reason}")]
     Read {
         /// The file.
         file: PathBuf,
-        /// The cause.
-        source: std::io::Error,
+        /// The operating system's reason (text, not a chained source, so it is printed once).
+        reason: String,
     },
     /// Syntax error, wrong type or unknown key.
     #[error("{file}:{line}: {message}")]
@@ -67,7 +74,7 @@ pub struct ServerSettings {
     /// Finished chunks kept in memory.
     pub chunk_cache: u64,
     /// Game mode of joining players: "creative", "survival", "adventure" or "spectator".
-    pub gamemode: String,
+    pub gamemode: GameMode,
 }
 
 impl Default for ServerSettings {
@@ -79,7 +86,7 @@ impl Default for ServerSettings {
             view_distance_cap: 12,
             chunk_threads: 2,
             chunk_cache: 4096,
-            gamemode: "creative".into(),
+            gamemode: GameMode::Creative,
         }
     }
 }
@@ -141,8 +148,8 @@ pub struct Config {
 impl Config {
     /// Reads and validates `path`.
     pub fn load(path: &Path) -> Result<Config, ConfigError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| ConfigError::Read { file: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ConfigError::Read { file: path.to_path_buf(), reason: e.to_string() })?;
         Config::parse(&text, path)
     }
 
@@ -184,13 +191,6 @@ impl Config {
         check_range("server.view_distance_cap", s.view_distance_cap, 2, 32)?;
         check_range("server.chunk_threads", s.chunk_threads, 1, 256)?;
         check_range("server.chunk_cache", s.chunk_cache, 0, 1_000_000)?;
-        if !["creative", "survival", "adventure", "spectator"].contains(&s.gamemode.as_str()) {
-            return Err(RangeError {
-                key: "server.gamemode".into(),
-                value: format!("{:?}", s.gamemode),
-                allowed: "\"creative\", \"survival\", \"adventure\" or \"spectator\"".into(),
-            });
-        }
         let w = &self.world;
         check_range("world.min_y", w.min_y, -2032, 2016)?;
         check_range("world.height", w.height, 16, 4064)?;

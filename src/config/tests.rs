@@ -63,3 +63,35 @@ fn learned_stage_names_and_backends_are_checked() {
     assert!(err.contains("engine.backend = \"cuda\"") && err.contains("\"wgpu\""), "{err}");
     assert_eq!(parse("[engine]\nlearned = [\"core\"]\n").unwrap().engine.learned, vec!["core".to_string()]);
 }
+
+#[test]
+fn the_game_mode_is_parsed_once_and_a_bad_one_names_file_line_key_and_values() {
+    let mode = |text: &str| parse(text).map(|c| c.server.gamemode);
+    assert_eq!(mode("[server]\ngamemode = \"survival\"\n").unwrap(), GameMode::Survival);
+    assert_eq!(mode("").unwrap(), GameMode::Creative);
+    let err = mode("[server]\nmax_players = 3\ngamemode = \"flying\"\n").unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "config/test.toml:3: server.gamemode = \"flying\" is out of range (allowed \"creative\", \"survival\", \
+         \"adventure\" or \"spectator\")"
+    );
+    let numbers: Vec<i32> = GameMode::ALL.iter().map(|m| m.game_type()).collect();
+    assert_eq!(numbers, [1, 0, 2, 3]);
+}
+
+#[test]
+fn the_built_in_config_is_the_shipped_file() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_PATH);
+    assert_eq!(shipped::CONFIG, std::fs::read_to_string(&path).expect("the shipped file"));
+    assert_eq!(Config::built_in(), Config::load(&path).expect("the shipped file loads"));
+}
+
+#[test]
+fn a_missing_file_is_named_once_with_the_reason_once() {
+    let err = Config::load(Path::new("no/such/config.toml")).unwrap_err();
+    let shown = format!("{:#}", anyhow::Error::from(err));
+    assert!(shown.starts_with("no/such/config.toml: cannot read the configuration file: "), "{shown}");
+    assert_eq!(shown.matches("No such file").count(), 1, "{shown}");
+    let named = Config::find(Some(Path::new("no/such/config.toml"))).unwrap_err().to_string();
+    assert!(named.contains("no/such/config.toml"), "{named}");
+}

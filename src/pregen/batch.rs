@@ -7,73 +7,77 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use clap::Args;
-
-use super::plan::{Plan, Shape, Shard, Task};
+use super::plan::{Plan, Shard, Task};
 use super::progress::{self, Progress, State};
 use super::{run_to_end, Hooks, Job};
-use crate::biome::BiomeRules;
-use crate::cli::Failure;
 use crate::config::Config;
-use crate::chunkgen::{BiomePalette, Generator};
-use crate::server::{check_biome_names, find_spawn};
-use crate::terrain::Pipeline;
-use crate::world::{self, ChunkSource, Store};
+use crate::chunkgen::BiomePalette;
+use crate::terrain::model_files::ModelFiles;
+use crate::world::{self, ChunkSource, OpenOptions, RulesSource, WorldError};
 
-/// Options of `infiniterra pregen`.
-#[derive(Clone, Debug, Args)]
-pub struct PregenArgs {
-    /// Centre block, `X,Z`.
-    #[arg(long, value_parser = parse_center, allow_hyphen_values = true)]
-    pub center: (i64, i64),
-    /// Radius in blocks.
-    #[arg(long)]
-    pub radius: i64,
-    /// Outline: square or circle.
-    #[arg(long, default_value = "square")]
-    pub shape: Shape,
-    /// World folder (default: `[world] directory` of the configuration).
-    #[arg(long)]
+/// What one batch run does (the command line's options, parsed).
+#[derive(Clone, Debug)]
+pub struct Batch {
+    /// The area.
+    pub task: Task,
+    /// World folder (`None`: `[world] directory` of the configuration).
     pub world: Option<PathBuf>,
-    /// Only this shard, `i/N` (0-based): regions are dealt round-robin to N shards.
-    #[arg(long, default_value = "0/1")]
+    /// Only this shard of the task's region files.
     pub shard: Shard,
-    /// Generating threads (default: `[server] chunk_threads`).
-    #[arg(long)]
+    /// Generating threads (`None`: `[server] chunk_threads`).
     pub threads: Option<usize>,
-    /// Seconds between progress lines.
-    #[arg(long, default_value_t = 5.0)]
-    pub report_every: f64,
-    /// Folder of biome rule files.
-    #[arg(long, default_value = "biomes")]
-    pub biomes: PathBuf,
+    /// Time between progress lines.
+    pub report_every: Duration,
+    /// Where the biome rules come from.
+    pub rules: RulesSource,
+    /// Where the learned stages' models come from.
+    pub models: ModelFiles,
 }
 
-fn parse_center(s: &str) -> Result<(i64, i64), String> {
-    let bad = || format!("centre {s:?}: expected X,Z in blocks, e.g. 0,0 or -512,1024");
-    let (x, z) = s.split_once(',').ok_or_else(bad)?;
-    Ok((x.trim().parse().map_err(|_| bad())?, z.trim().parse().map_err(|_| bad())?))
+/// Why a batch run did not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum PregenError {
+    /// The task or the progress file given is unusable (exit code 2).
+    #[error("{0}")]
+    Input(String),
+    /// The world cannot be opened (rules, models, world folder…).
+    #[error(transparent)]
+    World(#[from] WorldError),
+    /// Ctrl-C or SIGTERM paused the task; its progress is saved.
+    #[error("interrupted")]
+    Interrupted,
+    /// Anything else: a write failed, a thread could not start (exit code 1).
+    #[error("{0}")]
+    Runtime(String),
+}
+
+impl PregenError {
+    /// True when the owner's input is at fault (exit code 2), not the machine.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            PregenError::Input(_) => true,
+            PregenError::World(e) => e.is_bad_input(),
+            PregenError::Interrupted | PregenError::Runtime(_) => false,
+        }
+    }
 }
 
 /// Runs (or resumes) the task; returns when it is finished, or paused by an error or Ctrl-C.
-pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
-    let task = Task { center_x: args.center.0, center_z: args.center.1, radius: args.radius, shape: args.shape };
-    task.validate().map_err(|e| Failure::input(anyhow::anyhow!("{e}")))?;
-    let rules = BiomeRules::load_dir(&args.biomes)
-        .map_err(|e| Failure::input(anyhow::anyhow!("{}: {e}", args.biomes.display())))?;
-    check_biome_names(&rules).map_err(Failure::input)?;
-    let world_dir = args.world.clone().unwrap_or_else(|| config.world.directory.clone());
+pub fn run(config: &Config, batch: &Batch) -> Result<(), PregenError> {
+    let task = batch.task;
+    task.validate().map_err(PregenError::Input)?;
+    let world_dir = batch.world.clone().unwrap_or_else(|| config.world.directory.clone());
     let seed = config.world.seed;
-    let progress_path = progress::path(&world_dir, args.shard);
+    let progress_path = progress::path(&world_dir, batch.shard);
 
-    let saved = Progress::load(&progress_path).map_err(Failure::input)?;
-    let same = |p: &Progress| p.task == task && p.shard == args.shard && p.seed == seed;
+    let saved = Progress::load(&progress_path).map_err(|e| PregenError::Input(format!("{e:#}")))?;
+    let same = |p: &Progress| p.task == task && p.shard == batch.shard && p.seed == seed;
     let done = match saved {
         None => 0,
         // A finished task is history: a new task may follow it.
         Some(p) if !same(&p) && p.state == State::Finished => 0,
         Some(p) if !same(&p) => {
-            return Err(Failure::input(anyhow::anyhow!(
+            return Err(PregenError::Input(format!(
                 "{} belongs to another task ({}, shard {}, seed {}); finish it with that command, or remove \
                  the file to start this one",
                 progress_path.display(),
@@ -83,7 +87,7 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
             )))
         }
         Some(p) if p.state == State::Finished => {
-            println!("pregen: {task} (shard {}) is already finished: {} chunks", args.shard, p.total);
+            println!("pregen: {task} (shard {}) is already finished: {} chunks", batch.shard, p.total);
             return Ok(());
         }
         Some(p) => {
@@ -92,19 +96,22 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
         }
     };
 
-    let pipeline = Arc::new(Pipeline::build(seed, &config.terrain()).map_err(Failure::input)?);
-    let generator = Arc::new(Generator::new(pipeline, config));
-    let spawn = find_spawn(&generator, &rules);
-    world::prepare(&world_dir, seed, [spawn.block.x, spawn.block.y, spawn.block.z], game_type(config))
-        .map_err(Failure::input)?;
-    let store = Arc::new(Store::open(&world_dir).map_err(Failure::runtime)?);
+    let options = OpenOptions {
+        rules: batch.rules.clone(),
+        models: batch.models.clone(),
+        directory: Some(world_dir.clone()),
+        save: true,
+    };
+    let opened = world::open(config, &options, &mut |_| {})?;
+    let store = opened.store.clone().ok_or_else(|| PregenError::Runtime("the region store is not open".into()))?;
+    let rules = opened.rules;
     let palette = Arc::new(BiomePalette::vanilla());
-    let source = Arc::new(ChunkSource::new(generator, palette, Some(store.clone())));
+    let source = Arc::new(ChunkSource::new(opened.generator, palette, Some(store.clone())));
 
-    let plan = Plan::new(task, args.shard);
+    let plan = Plan::new(task, batch.shard);
     println!(
         "pregen: {task}, shard {}: {} chunks in {} region files, into {}",
-        args.shard,
+        batch.shard,
         super::thousands(plan.total()),
         plan.regions().len(),
         store.region_dir().display()
@@ -117,12 +124,12 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
         progress_path.clone(),
         done,
         Hooks {
-            report_every: Duration::from_secs_f64(args.report_every.max(0.0)),
+            report_every: batch.report_every,
             report: Box::new(|line| println!("{line}")),
             on_work: Box::new(|| {}),
         },
     )
-    .map_err(|e| Failure::runtime(anyhow::anyhow!("cannot write {}: {e}", progress_path.display())))?;
+    .map_err(|e| PregenError::Runtime(format!("cannot write {}: {e}", progress_path.display())))?;
 
     // Ctrl-C / SIGTERM pause the task; its progress is saved and the same command resumes it.
     let interrupted = Arc::new(AtomicBool::new(false));
@@ -132,12 +139,12 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
             interrupted.store(true, Ordering::SeqCst);
             job.pause();
         })
-        .map_err(Failure::runtime)?;
+        .map_err(|e| PregenError::Runtime(format!("cannot handle Ctrl-C: {e}")))?;
     }
 
-    let threads = args.threads.unwrap_or(config.server.chunk_threads as usize).max(1);
+    let threads = batch.threads.unwrap_or(config.server.chunk_threads as usize).max(1);
     let status = run_to_end(&job, &source, &rules, threads);
-    store.close().map_err(Failure::runtime)?;
+    store.close().map_err(|e| PregenError::Runtime(format!("saving the world: {e}")))?;
     let elapsed = started.elapsed().as_secs_f64();
     match status.state {
         State::Finished => {
@@ -151,21 +158,11 @@ pub fn run(config: &Config, args: &PregenArgs) -> Result<(), Failure> {
         }
         _ if interrupted.load(Ordering::SeqCst) => {
             println!("pregen: paused at {}; run the same command again to continue", status.line());
-            Err(Failure { code: 130, error: anyhow::anyhow!("interrupted") })
+            Err(PregenError::Interrupted)
         }
-        _ => Err(Failure::runtime(anyhow::anyhow!(
+        _ => Err(PregenError::Runtime(format!(
             "pre-generation paused: {}; fix the cause and run the same command again to continue",
             status.error.unwrap_or_else(|| "unknown error".into())
         ))),
-    }
-}
-
-/// Minecraft's game type number for `[server] gamemode`.
-pub fn game_type(config: &Config) -> i32 {
-    match config.server.gamemode.as_str() {
-        "survival" => 0,
-        "adventure" => 2,
-        "spectator" => 3,
-        _ => 1,
     }
 }

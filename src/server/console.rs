@@ -10,10 +10,10 @@ use std::sync::{Arc, Mutex, PoisonError};
 
 use valence::prelude::*;
 
+use super::dimension::WorldSetup;
 use super::lifecycle::StopRequest;
 use super::stream::Streamer;
-use super::world::{check_biome_names, WorldSetup};
-use crate::biome::BiomeRules;
+use crate::world::RulesSource;
 
 const HELP: &str = "commands:
   help     this list
@@ -105,17 +105,17 @@ fn print_status(streamer: Option<&mut Streamer>, clients: &Query<&Username, With
 
 /// Re-reads the rules; bad rules are reported and the current ones stay.
 fn reload(setup: &mut WorldSetup, streamer: Option<&mut Streamer>) {
-    let loaded = BiomeRules::load_dir(&setup.biomes_dir)
-        .map_err(|e| anyhow::anyhow!("{e}"))
-        .and_then(|rules| check_biome_names(&rules).map(|()| rules));
-    match loaded {
+    if setup.rules_source == RulesSource::BuiltIn {
+        say!(
+            "reload: the biome rules are the ones built into the binary, so there is nothing to re-read; \
+             start with `serve --biomes DIR` (or a biomes/ folder here) to edit them"
+        );
+        return;
+    }
+    match setup.rules_source.load() {
         Ok(rules) => {
             let rules = Arc::new(rules);
-            say!(
-                "reloaded {} biome rules from {}; new chunks use them",
-                rules.rule_count(),
-                setup.biomes_dir.display()
-            );
+            say!("reloaded {} biome rules from {}; new chunks use them", rules.rule_count(), setup.rules_source);
             setup.rules = rules.clone();
             if let Some(s) = streamer {
                 s.set_rules(rules);

@@ -3,7 +3,8 @@
 //! Owns: the valence app, players joining and their spawn, streaming chunks to their views,
 //! the console, start-up and shutdown. Must not touch: how terrain is made (asks
 //! [`Pipeline`](crate::terrain::Pipeline) through [`chunkgen`](crate::chunkgen)) or how blocks are
-//! chosen (chunk generation's). Data flows one way: server → chunkgen → pipeline.
+//! chosen (chunk generation's), or how the world is opened ([`world::open`], shared with `pregen`).
+//! Data flows one way: server → world → chunkgen → pipeline.
 
 /// Prints a line for the owner. A closed stdout (the console piped into a process that has
 /// exited) must not take the server down with a panic, so write errors are ignored.
@@ -15,32 +16,28 @@ macro_rules! say {
 }
 
 mod console;
+mod dimension;
 mod lifecycle;
 mod players;
 mod pregen;
-mod spawn;
 mod stream;
-mod world;
 
 use std::net::{SocketAddr, TcpListener};
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use valence::prelude::*;
 
-use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::chunkgen::Generator;
-use crate::terrain::Pipeline;
-
-pub use spawn::{find_spawn, SpawnPoint};
-pub use world::check_biome_names;
+use crate::terrain::model_files::ModelFiles;
+use crate::world::{self, OpenOptions, Opening, RulesSource, SpawnPoint, WorldError};
 
 /// Options of `infiniterra serve` beyond the configuration file.
 #[derive(Clone, Debug)]
 pub struct ServeOptions {
-    /// Folder of biome rule files (`*.toml`), re-read by the console's `reload`.
-    pub biomes_dir: PathBuf,
+    /// Where the biome rules come from (a folder is re-read by the console's `reload`).
+    pub rules: RulesSource,
+    /// Where the learned stages' models come from.
+    pub models: ModelFiles,
 }
 
 /// Why the server could not start or stopped with an error.
@@ -54,11 +51,24 @@ pub enum ServeError {
     Runtime(anyhow::Error),
 }
 
+impl From<WorldError> for ServeError {
+    fn from(e: WorldError) -> ServeError {
+        if e.is_bad_input() {
+            ServeError::Input(e.into())
+        } else {
+            ServeError::Runtime(e.into())
+        }
+    }
+}
+
+/// Where players appear, as the app's resource.
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct Spawn(pub SpawnPoint);
+
 /// Runs the server until `stop` on the console, Ctrl-C or SIGTERM.
 pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> {
-    let rules = BiomeRules::load_dir(&options.biomes_dir)
-        .map_err(|e| ServeError::Input(anyhow::anyhow!("{}: {e}", options.biomes_dir.display())))?;
-    world::check_biome_names(&rules).map_err(ServeError::Input)?;
+    // Bad rules are the owner's to fix: say so before anything touches the network.
+    options.rules.load()?;
 
     let address = config.bind_address();
     if address.port() == 0 {
@@ -74,37 +84,25 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
         );
     }
 
-    let pipeline =
-        Pipeline::build(config.world.seed, &config.terrain()).map_err(|e| ServeError::Input(anyhow::anyhow!("{e}")))?;
-    // Owners should see at once whether the learned stages run (and from which folder).
-    let learned = pipeline.learned_stages();
-    if learned.is_empty() {
-        say!("terrain: procedural layout only (engine.learned = [])");
-    } else {
-        say!(
-            "terrain: learned stages {} from {} on {}",
-            learned.join(", "),
-            config.engine.models.display(),
-            config.engine.backend
-        );
-    }
-    let pipeline = Arc::new(pipeline);
-    let generator = Arc::new(Generator::new(pipeline, config));
-    say!("seed {}: finding a spawn point on land near the origin…", config.world.seed);
-    let spawn = find_spawn(&generator, &rules);
-    say!("spawn point: x {} y {} z {}", spawn.block.x, spawn.block.y, spawn.block.z);
-    let store = if config.world.save_chunks {
-        let dir = &config.world.directory;
-        let at = [spawn.block.x, spawn.block.y, spawn.block.z];
-        crate::world::prepare(dir, config.world.seed, at, crate::pregen::batch::game_type(config))
-            .map_err(ServeError::Input)?;
-        let store = crate::world::Store::open(dir)
-            .map_err(|e| ServeError::Runtime(anyhow::anyhow!("cannot start the region writer: {e}")))?;
-        say!("saving the world to {}", dir.display());
-        Some(Arc::new(store))
-    } else {
-        None
+    let open = OpenOptions {
+        rules: options.rules.clone(),
+        models: options.models.clone(),
+        directory: None,
+        save: config.world.save_chunks,
     };
+    let opened = world::open(config, &open, &mut |step| match step {
+        // Owners should see at once whether the learned stages run (and from where).
+        Opening::Terrain([]) => say!("terrain: procedural layout only (engine.learned = [])"),
+        Opening::Terrain(learned) => {
+            say!("terrain: learned stages {} from {} on {}", learned.join(", "), options.models, config.engine.backend)
+        }
+        Opening::FindingSpawn => {
+            say!("seed {}: finding a spawn point on land near the origin…", config.world.seed)
+        }
+        Opening::Spawn(spawn) => say!("spawn point: x {} y {} z {}", spawn.block.x, spawn.block.y, spawn.block.z),
+        Opening::Saving(dir) => say!("saving the world to {}", dir.display()),
+    })?;
+    let store = opened.store.clone();
     let pregen = pregen::PregenControl::default();
 
     let exit = lifecycle::ExitCode::default();
@@ -120,16 +118,16 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
         ..Default::default()
     })
     .add_plugins(DefaultPlugins)
-    .insert_resource(world::WorldSetup {
+    .insert_resource(dimension::WorldSetup {
         config: config.clone(),
-        generator,
-        rules: Arc::new(rules),
-        biomes_dir: options.biomes_dir.clone(),
+        generator: opened.generator,
+        rules: Arc::new(opened.rules),
+        rules_source: options.rules.clone(),
         store: store.clone(),
     })
-    .insert_resource(spawn)
+    .insert_resource(Spawn(opened.spawn))
     .insert_resource(exit.clone());
-    world::build(&mut app);
+    dimension::build(&mut app);
     players::build(&mut app, config);
     stream::build(&mut app);
     console::build(&mut app);

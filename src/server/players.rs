@@ -9,7 +9,7 @@ use valence::prelude::*;
 
 use crate::config::Config;
 
-use super::spawn::SpawnPoint;
+use super::Spawn;
 
 /// Systems that place players and set their view: streaming runs after them, so it never
 /// loads chunks for where a player was before being placed.
@@ -26,23 +26,13 @@ struct PlayerSettings {
 /// Adds the player systems.
 pub fn build(app: &mut App, config: &Config) {
     app.insert_resource(PlayerSettings {
-        game_mode: game_mode(&config.server.gamemode),
+        game_mode: config.server.gamemode.client(),
         view_distance_cap: config.server.view_distance_cap.clamp(2, 32) as u8,
     })
     .add_systems(Update, (init_clients, cap_view_distance).in_set(PlayersSet))
     .add_systems(Update, (despawn_disconnected_clients, announce_leaving))
     // After valence has sent the join packet, before this tick's packets leave.
     .add_systems(PostUpdate, send_health.after(UpdateClientsSet).before(FlushPacketsSet));
-}
-
-/// The configured game mode (validated at load; anything else is creative).
-pub fn game_mode(name: &str) -> GameMode {
-    match name {
-        "survival" => GameMode::Survival,
-        "adventure" => GameMode::Adventure,
-        "spectator" => GameMode::Spectator,
-        _ => GameMode::Creative,
-    }
 }
 
 #[allow(clippy::type_complexity)]
@@ -60,7 +50,7 @@ fn init_clients(
         Added<Client>,
     >,
     layers: Query<Entity, (With<ChunkLayer>, With<EntityLayer>)>,
-    spawn: Res<SpawnPoint>,
+    spawn: Res<Spawn>,
     settings: Res<PlayerSettings>,
 ) {
     let Ok(layer) = layers.get_single() else {
@@ -70,8 +60,8 @@ fn init_clients(
         layer_id.0 = layer;
         visible_chunks.0 = layer;
         visible_entities.0.insert(layer);
-        pos.set(spawn.feet);
-        *respawn = RespawnPosition { pos: spawn.block, yaw: 0.0 };
+        pos.set(spawn.0.feet);
+        *respawn = RespawnPosition { pos: spawn.0.block, yaw: 0.0 };
         *mode = settings.game_mode;
         say!("{} joined", name.0);
     }

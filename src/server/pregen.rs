@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex, PoisonError};
 
 use valence::prelude::*;
 
+use super::dimension::WorldSetup;
 use super::stream::Streamer;
-use super::world::WorldSetup;
 use crate::pregen::{progress, thousands, Hooks, Job, Plan, Progress, Shape, Shard, State, Task};
 
 /// Console help for the pregen commands.

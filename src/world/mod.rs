@@ -1,6 +1,7 @@
-//! The saved world: Anvil region files, the chunk ⇄ NBT codec, `level.dat`, the store that
-//! loads chunks from disk and writes new ones off the main thread, and the chunk source that
-//! puts the store in front of the generator.
+//! The world a run plays in: opening it ([`open`]: rules, generator, spawn point, `level.dat`,
+//! store — the same for `serve` and `pregen`), and the saved world: Anvil region files, the
+//! chunk ⇄ NBT codec, `level.dat`, the store that loads chunks from disk and writes new ones
+//! off the main thread, and the chunk source that puts the store in front of the generator.
 //!
 //! Owns: everything on disk under the world directory. Must not: decide which chunks are
 //! wanted (the server's and the pre-generator's) or how terrain looks (the generator's).
@@ -8,12 +9,16 @@
 mod chunks;
 pub mod codec;
 pub mod level;
+mod open;
 pub mod region;
+pub mod spawn;
 mod store;
 
 use std::path::Path;
 
 pub use chunks::{ChunkSource, Origin, Scratch};
+pub use open::{check_biome_names, open, OpenOptions, OpenWorld, Opening, RulesSource, WorldError};
+pub use spawn::{find_spawn, SpawnPoint};
 pub use store::{Store, StoreError};
 
 /// Makes `dir` ready for chunks of the world with `seed`: a world made with another seed is

@@ -191,16 +191,18 @@ impl Store {
     /// so a later flush reports only newer trouble.
     pub fn flush(&self) -> Result<(), StoreError> {
         let jobs = self.jobs.lock().unwrap_or_else(PoisonError::into_inner).clone();
-        let jobs = jobs.ok_or(StoreError::WriterGone)?;
-        let (answer, reply) = mpsc::sync_channel(1);
-        jobs.send(Job::Flush(answer)).map_err(|_| StoreError::WriterGone)?;
-        reply.recv().map_err(|_| StoreError::WriterGone)?
+        flush_through(&jobs.ok_or(StoreError::WriterGone)?)
     }
 
-    /// Flushes, then stops the writer thread.
+    /// Flushes, then stops the writer thread. Closing a closed store does nothing and returns
+    /// `Ok`: the owner closes explicitly to see the error, and `Drop` closes again.
     pub fn close(&self) -> Result<(), StoreError> {
-        let flushed = self.flush();
-        self.jobs.lock().unwrap_or_else(PoisonError::into_inner).take();
+        // Taking the sender under its lock makes exactly one caller the closer.
+        let Some(jobs) = self.jobs.lock().unwrap_or_else(PoisonError::into_inner).take() else {
+            return Ok(());
+        };
+        let flushed = flush_through(&jobs);
+        drop(jobs);
         if let Some(writer) = self.writer.lock().unwrap_or_else(PoisonError::into_inner).take() {
             let _ = writer.join();
         }
@@ -214,6 +216,13 @@ impl Drop for Store {
             tracing::error!("saving the world: {e}");
         }
     }
+}
+
+/// Asks the writer behind `jobs` to write and fsync everything queued, and waits for it.
+fn flush_through(jobs: &SyncSender<Job>) -> Result<(), StoreError> {
+    let (answer, reply) = mpsc::sync_channel(1);
+    jobs.send(Job::Flush(answer)).map_err(|_| StoreError::WriterGone)?;
+    reply.recv().map_err(|_| StoreError::WriterGone)?
 }
 
 fn write_loop(files: &Files, queue: &Receiver<Job>, failure: &Mutex<Option<String>>) {
@@ -298,6 +307,20 @@ mod tests {
         }
         assert_eq!(again.load(5000, 5000).expect("absent"), None);
         assert!(!again.contains(5000, 5000).expect("absent"));
+    }
+
+    #[test]
+    fn closing_twice_is_a_quiet_no_op() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let store = Store::open(dir.path()).expect("store");
+        store.save(3, 4, &nbt_of(3, 4)).expect("save");
+        store.close().expect("first close");
+        // The second close (as `Drop` does after an explicit one) neither fails nor logs.
+        store.close().expect("second close is Ok");
+        assert!(matches!(store.save(0, 0, &nbt_of(0, 0)), Err(StoreError::WriterGone)));
+        drop(store);
+        let again = Store::open(dir.path()).expect("reopen");
+        assert_eq!(again.load(3, 4).expect("load"), Some(nbt_of(3, 4)));
     }
 
     #[test]

@@ -11,6 +11,7 @@ pub mod layout;
 pub mod metrics;
 #[cfg(feature = "learned")]
 pub mod model;
+pub mod model_files;
 pub mod noise;
 pub mod pipeline;
 pub mod settings;

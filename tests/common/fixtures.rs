@@ -13,7 +13,7 @@ pub use infiniterra::{
     biome::BiomeRules,
     config::Config,
     chunkgen::{BiomePalette, Generator, SkyLight},
-    server::find_spawn,
+    world::find_spawn,
     terrain::Pipeline,
 };
 

@@ -23,8 +23,8 @@ use valence::protocol::WritePacket;
 
 use self::cache::ChunkCache;
 use self::workers::{Built, Finished, Results, Workers};
+use super::dimension::{Palette, WorldSetup};
 use super::players::PlayersSet;
-use super::world::{Palette, WorldSetup};
 use crate::biome::BiomeRules;
 use crate::pregen::Job;
 use crate::world::ChunkSource;

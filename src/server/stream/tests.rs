@@ -20,7 +20,7 @@ use super::Streamer;
 use crate::biome::BiomeRules;
 use crate::config::Config;
 use crate::chunkgen::Generator;
-use crate::server::world::{self, WorldSetup};
+use crate::server::dimension::{self, WorldSetup};
 use crate::terrain::Pipeline;
 
 /// A client whose packets go nowhere and who never says anything.
@@ -59,11 +59,11 @@ fn app() -> (App, Entity) {
             config,
             generator,
             rules: Arc::new(rules),
-            biomes_dir: PathBuf::new(),
+            rules_source: crate::world::RulesSource::BuiltIn,
             store: None,
         })
         .add_systems(Update, despawn_disconnected_clients);
-    world::build(&mut app);
+    dimension::build(&mut app);
     super::build(&mut app);
     app.update(); // Start-up: the layer and the workers.
     let layer = app.world.query_filtered::<Entity, With<ChunkLayer>>().single(&app.world);

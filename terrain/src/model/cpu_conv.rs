@@ -18,7 +18,10 @@
 use burn::tensor::{Device, Tensor, TensorData};
 use rayon::prelude::*;
 
-use super::layers::SILU_MAGNITUDE;
+/// E[silu(x)²]^½ for x ~ N(0, 1): dividing by it keeps unit magnitude (EDM2's constant).
+/// Defined here, at the bottom of the model's layers, because both this kernel's fused SiLU
+/// and the layers' `mp_silu` divide by it.
+pub(super) const SILU_MAGNITUDE: f32 = 0.596;
 
 /// Output positions (in the padded row stride) per GEMM: the band's right-hand side,
 /// `k²·c_in` rows of this many floats, stays within L2.

@@ -13,14 +13,11 @@ use burn::tensor::module::conv2d;
 use burn::tensor::ops::ConvOptions;
 use burn::tensor::{Device, Tensor, TensorData};
 
-use super::cpu_conv::{self, Pre};
+use super::cpu_conv::{self, Pre, SILU_MAGNITUDE};
 use super::rng::HostRng;
 
 /// Keeps the weight norm away from zero (EDM2's value).
 const NORM_EPS: f32 = 1e-4;
-
-/// E[silu(x)²]^½ for x ~ N(0, 1): dividing by it keeps unit magnitude (EDM2's constant).
-pub(super) const SILU_MAGNITUDE: f32 = 0.596;
 
 /// Normalises every "row" (everything but dim 0) of a weight to RMS 1, i.e. to norm √fan_in.
 pub fn normalize_rows<const D: usize>(w: Tensor<D>) -> Tensor<D> {

@@ -41,8 +41,8 @@ pub use projection::ContextProjection;
 pub use rng::HostRng;
 pub use sampler::{Guide, Sampler, SamplerKind};
 pub use store::{
-    load_model, load_model_file, save_model, sha256_file, sha256_hex, DataChecksum, Guidance, LoadedModel, ModelError,
-    ModelManifest, Normalisation, Precision, TrainingRecord,
+    load_model, load_model_file, load_model_from, save_model, sha256_file, sha256_hex, DataChecksum, Guidance,
+    LoadedModel, ModelError, ModelManifest, Normalisation, Precision, TrainingRecord,
 };
 pub use unet::{UNet, UNetConfig};
 

@@ -22,6 +22,7 @@ use super::projection::ContextProjection;
 use super::sampler::Sampler;
 use super::unet::{UNet, UNetConfig};
 use crate::encoding::ContextSpec;
+use crate::model_files::ModelFiles;
 
 /// Version of the manifest layout; bumped on incompatible changes.
 const MANIFEST_VERSION: u32 = 1;
@@ -323,15 +324,31 @@ pub fn save_model(
 /// Loads `<dir>/<stage>.json` and the weights it names onto `device`, verifying size and
 /// checksum first.
 pub fn load_model(dir: &Path, stage: &str, device: &Device) -> Result<LoadedModel, ModelError> {
-    load_model_file(&dir.join(format!("{stage}.json")), device)
+    load_model_from(&ModelFiles::Dir(dir.to_path_buf()), stage, device)
+}
+
+/// Loads `<stage>.json` of `files` (a folder, or the models built into the binary) and the
+/// weights it names onto `device`, verifying size and checksum first.
+pub fn load_model_from(files: &ModelFiles, stage: &str, device: &Device) -> Result<LoadedModel, ModelError> {
+    load_manifest_at(files, Path::new(&format!("{stage}.json")), device)
 }
 
 /// Loads a model from the path of its manifest.
 pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedModel, ModelError> {
-    let stage = manifest_path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = manifest_path.parent().unwrap_or(Path::new("."));
+    let name = manifest_path.file_name().map_or_else(|| manifest_path.to_path_buf(), PathBuf::from);
+    load_manifest_at(&ModelFiles::Dir(dir.to_path_buf()), &name, device)
+}
+
+/// Loads the model whose manifest is `rel` in `files`; every file it names is relative to the
+/// manifest's folder.
+fn load_manifest_at(files: &ModelFiles, rel: &Path, device: &Device) -> Result<LoadedModel, ModelError> {
+    let manifest_path = files.shown(rel);
+    let manifest_path = manifest_path.as_path();
+    let stage = rel.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let default_command = format!("infiniterra train {stage}");
-    let text = match std::fs::read_to_string(manifest_path) {
-        Ok(t) => t,
+    let text = match files.read(rel) {
+        Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             return Err(ModelError::Missing { path: manifest_path.to_path_buf(), command: default_command })
         }
@@ -398,11 +415,12 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
         )));
     }
 
-    let dir = manifest_path.parent().unwrap_or(Path::new("."));
-    let weights_path = dir.join(&manifest.weights);
+    let dir = rel.parent().unwrap_or(Path::new(""));
+    let weights_rel = dir.join(&manifest.weights);
+    let weights_path = files.shown(&weights_rel);
     let corrupt = |reason: String| ModelError::Corrupt { path: weights_path.clone(), reason, command: command.clone() };
-    let bytes = match std::fs::read(&weights_path) {
-        Ok(b) => b,
+    let bytes = match files.read(&weights_rel) {
+        Ok(b) => b.into_owned(),
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             return Err(ModelError::Missing { path: weights_path.clone(), command: command.clone() })
         }
@@ -432,15 +450,22 @@ pub fn load_model_file(manifest_path: &Path, device: &Device) -> Result<LoadedMo
     let guide = match &manifest.guidance {
         None => None,
         // The guide's own errors name its files and the command that recreates it.
-        Some(g) => Some(load_guide(dir, g, &manifest, device)?),
+        Some(g) => Some(load_guide(files, dir, g, &manifest, device)?),
     };
     Ok(LoadedModel { net, manifest, guide })
 }
 
 /// Loads the guide a manifest's `guidance` names and checks it can guide `main`: the same
 /// normalisation and conditioning (both networks see the same inputs), no guide of its own.
-fn load_guide(dir: &Path, g: &Guidance, main: &ModelManifest, device: &Device) -> Result<UNet, ModelError> {
-    let path = dir.join(&g.guide);
+fn load_guide(
+    files: &ModelFiles,
+    dir: &Path,
+    g: &Guidance,
+    main: &ModelManifest,
+    device: &Device,
+) -> Result<UNet, ModelError> {
+    let rel = dir.join(&g.guide);
+    let path = files.shown(&rel);
     let corrupt = |reason: String| ModelError::Corrupt { path: path.clone(), reason, command: main.recreate.clone() };
     if !(g.weight.is_finite() && (0.0..=10.0).contains(&g.weight)) || g.steps == 0 {
         return Err(corrupt(format!(
@@ -448,7 +473,7 @@ fn load_guide(dir: &Path, g: &Guidance, main: &ModelManifest, device: &Device) -
             g.weight, g.steps
         )));
     }
-    let guide = load_model_file(&path, device)?;
+    let guide = load_manifest_at(files, &rel, device)?;
     let (a, b) = (&guide.manifest, main);
     if a.guidance.is_some() {
         return Err(corrupt("a guide cannot have a guide of its own".into()));

@@ -15,6 +15,7 @@ use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
+use crate::model_files::ModelFiles;
 use crate::settings::{StageName, TerrainSettings};
 use crate::tile::{Rect, Tile};
 use crate::upsample;
@@ -141,6 +142,16 @@ impl Pipeline {
     /// Builds the pipeline of `seed` with validated `settings`, loading the learned stages
     /// they name (`engine.learned`) from `engine.models` on `engine.backend`.
     pub fn build(seed: u64, settings: &TerrainSettings) -> Result<Pipeline, PipelineError> {
+        Pipeline::build_with_models(seed, settings, &ModelFiles::Dir(settings.engine.models.clone()))
+    }
+
+    /// [`Pipeline::build`], reading the learned stages from `models` (a folder, or the models
+    /// built into the binary) instead of `engine.models`.
+    pub fn build_with_models(
+        seed: u64,
+        settings: &TerrainSettings,
+        models: &ModelFiles,
+    ) -> Result<Pipeline, PipelineError> {
         let engine = Engine::new(EngineConfig {
             cache_bytes: (settings.engine.cache_mib as usize) << 20,
             threads: settings.engine.threads as usize,
@@ -154,7 +165,7 @@ impl Pipeline {
         let mut ran: Vec<StageGrid> = Vec::new();
         for spec in LEARNED.iter().filter(|s| settings.engine.runs(s.name)) {
             let above = ran.iter().rev().find(|g| g.name == spec.context_stage).unwrap_or(&sketch);
-            let grid = learned_stage(spec, seed, settings, &engine, above, &mut stages)?;
+            let grid = learned_stage(spec, seed, settings, models, &engine, above, &mut stages)?;
             ran.push(grid);
         }
         // The coarse grid (climate, spawn search) carries the finest stage that lives on it.
@@ -335,20 +346,22 @@ impl StageGrid {
 /// averaged further when the model's context, `context.factor` of its own pixels, is coarser
 /// than `above`'s grid). Marks the stage active.
 #[cfg(feature = "learned")]
+#[allow(clippy::too_many_arguments)] // The stage's whole context; one call site per stage.
 fn learned_stage(
     spec: &LearnedStageSpec,
     seed: u64,
     settings: &TerrainSettings,
+    models: &ModelFiles,
     engine: &Arc<Engine>,
     above: &StageGrid,
     stages: &mut [StageStatus],
 ) -> Result<StageGrid, PipelineError> {
-    use crate::model::{load_model, stage::LearnedStage, ComputeBackend};
+    use crate::model::{load_model_from, stage::LearnedStage, ComputeBackend};
     let name = spec.name;
     let backend: ComputeBackend = settings.engine.backend.as_str().parse()?;
     let device = backend.device()?;
-    let model = load_model(&settings.engine.models, name, &device)?;
-    let file = settings.engine.models.join(format!("{name}.json")).display().to_string();
+    let model = load_model_from(models, name, &device)?;
+    let file = models.shown(std::path::Path::new(&format!("{name}.json"))).display().to_string();
     let metres = model.manifest.metres_per_pixel;
     // The stage's place in the hierarchy is its grid: a model trained at another resolution
     // would put its relief at the wrong scale.
@@ -385,10 +398,12 @@ fn learned_stage(
 }
 
 #[cfg(not(feature = "learned"))]
+#[allow(clippy::too_many_arguments)]
 fn learned_stage(
     _spec: &LearnedStageSpec,
     _seed: u64,
     settings: &TerrainSettings,
+    _models: &ModelFiles,
     _engine: &Arc<Engine>,
     _above: &StageGrid,
     _stages: &mut [StageStatus],

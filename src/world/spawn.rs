@@ -1,6 +1,6 @@
 //! Where players appear: on dry, walkable land as near the origin as the world allows.
 
-use valence::prelude::*;
+use valence::prelude::{BlockPos, BlockState, DVec3};
 
 use crate::biome::BiomeRules;
 use crate::chunkgen::{Columns, Generator, CHUNK};
@@ -16,7 +16,7 @@ const MAX_RINGS: i64 = 200;
 const MAX_DROP: i32 = 1;
 
 /// The spawn point.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpawnPoint {
     /// The column and ground block players stand on.
     pub block: BlockPos,

@@ -1,15 +1,14 @@
 //! The world's shape as the client sees it: the dimension (height, floor) and the biome
-//! registry, and the one chunk layer everyone plays in.
+//! registry, and the one chunk layer everyone plays in. (The saved world is `crate::world`.)
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use valence::prelude::*;
 
 use crate::biome::BiomeRules;
 use crate::config::Config;
-use crate::chunkgen::{vanilla_biome_names, BiomePalette, Generator};
-use crate::world::Store;
+use crate::chunkgen::{BiomePalette, Generator};
+use crate::world::{RulesSource, Store};
 
 /// What start-up hands the app: configuration, generator and the biome rules.
 #[derive(Resource)]
@@ -21,7 +20,7 @@ pub struct WorldSetup {
     /// The biome rules loaded at start-up.
     pub rules: Arc<BiomeRules>,
     /// Where `reload` reads rules from.
-    pub biomes_dir: PathBuf,
+    pub rules_source: RulesSource,
     /// The saved world's region files (`None` when `world.save_chunks` is off).
     pub store: Option<Arc<Store>>,
 }
@@ -34,20 +33,6 @@ pub struct Palette(pub Arc<BiomePalette>);
 /// Adds the start-up systems.
 pub fn build(app: &mut App) {
     app.add_systems(Startup, (reshape_dimension, apply_deferred, create_layer).chain());
-}
-
-/// Refuses rules that name a biome the client does not know: it would silently become plains.
-pub fn check_biome_names(rules: &BiomeRules) -> anyhow::Result<()> {
-    let known = vanilla_biome_names();
-    let unknown: Vec<&str> = rules.biome_names().into_iter().filter(|n| !known.iter().any(|k| k == n)).collect();
-    if unknown.is_empty() {
-        Ok(())
-    } else {
-        anyhow::bail!(
-            "biome rules name biomes that Minecraft 1.20.1 does not have: {} (names look like \"minecraft:plains\")",
-            unknown.join(", ")
-        )
-    }
 }
 
 /// Players are in vanilla's overworld (clients know its sky and fog), reshaped to the

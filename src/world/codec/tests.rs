@@ -9,6 +9,7 @@ use valence::nbt::{Compound, List, Value};
 use valence::prelude::{BiomeId, BlockState, Chunk, PropName, PropValue, UnloadedChunk};
 use valence::registry::RegistryIdx;
 
+use super::nbt::{bit_width, packed_len};
 use super::*;
 use crate::biome::BiomeRules;
 use crate::config::Config;
