@@ -14,7 +14,9 @@ pub mod model;
 pub mod model_files;
 pub mod noise;
 pub mod pipeline;
+pub mod range;
 pub mod settings;
+pub mod stages;
 pub mod tile;
 pub mod upsample;
 

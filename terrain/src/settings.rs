@@ -10,28 +10,8 @@ use serde::Deserialize;
 
 pub use crate::climate::ClimateSettings;
 pub use crate::layout::LayoutSettings;
-use crate::pipeline::stages::{self, LearnedStageSpec};
-
-/// A setting outside its allowed range.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{key} = {value} is out of range (allowed {allowed})")]
-pub struct RangeError {
-    /// Dotted key, e.g. `layout.ocean_fraction`.
-    pub key: String,
-    /// The value given, as written.
-    pub value: String,
-    /// The allowed range, e.g. `0.05..=0.95`.
-    pub allowed: String,
-}
-
-/// Checks `min <= value <= max`, naming `key` on failure.
-pub fn check_range<T: PartialOrd + std::fmt::Display>(key: &str, value: T, min: T, max: T) -> Result<(), RangeError> {
-    if value >= min && value <= max {
-        Ok(())
-    } else {
-        Err(RangeError { key: key.to_string(), value: value.to_string(), allowed: format!("{min}..={max}") })
-    }
-}
+pub use crate::range::{check_range, RangeError};
+use crate::stages::{self, LearnedStageSpec};
 
 /// A learned stage named in `engine.learned`: always an entry of the stage table
 /// ([`stages::LEARNED`]), so code holding one never meets an unknown name.

@@ -1,14 +1,10 @@
 //! Checkpoints under `<out>/checkpoints/<stage>/`: what they record besides tensors, where
 //! their files lie, and writing them so that an interruption never leaves a broken one.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{anyhow, Context};
-use infiniterra_terrain::model::burn::module::Module;
 use infiniterra_terrain::model::{NoiseDistribution, Normalisation, UNetConfig};
 use serde::{Deserialize, Serialize};
-
-use super::trainer::Trainer;
 
 /// What a checkpoint records besides tensors.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -66,28 +62,5 @@ impl CheckpointPaths {
     }
     pub(super) fn optim(&self) -> PathBuf {
         self.dir.join("optim.bpk")
-    }
-}
-
-impl Trainer {
-    /// Writes the checkpoint (model, EMA, optimiser, state), each through a temporary file
-    /// and the state last, so an interruption mid-write leaves the previous one usable.
-    pub(super) fn checkpoint(&mut self, wall_seconds: f64) -> anyhow::Result<()> {
-        self.state.wall_seconds = wall_seconds;
-        std::fs::create_dir_all(&self.paths.dir).with_context(|| format!("creating {}", self.paths.dir.display()))?;
-        let tmp = |p: &Path| p.with_extension("tmp.bpk");
-        let (model, ema, optim) = (self.paths.model(), self.paths.ema(), self.paths.optim());
-        self.net.clone().save_file(tmp(&model)).map_err(|e| anyhow!("writing {}: {e}", model.display()))?;
-        self.ema.clone().save_file(tmp(&ema)).map_err(|e| anyhow!("writing {}: {e}", ema.display()))?;
-        self.optim.save(tmp(&optim)).map_err(|e| anyhow!("writing {}: {e}", optim.display()))?;
-        let state_tmp = self.paths.state().with_extension("json.tmp");
-        std::fs::write(&state_tmp, serde_json::to_string_pretty(&self.state)?)
-            .with_context(|| format!("writing {}", state_tmp.display()))?;
-        for p in [&model, &ema, &optim] {
-            std::fs::rename(tmp(p), p).with_context(|| format!("moving {} into place", p.display()))?;
-        }
-        std::fs::rename(&state_tmp, self.paths.state())
-            .with_context(|| format!("writing {}", self.paths.state().display()))?;
-        Ok(())
     }
 }

@@ -2,7 +2,7 @@
 //! validation losses and preview PNGs; a run starts fresh, from its checkpoint or from a
 //! shipped model.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -302,4 +302,27 @@ impl Trainer {
 fn hms(secs: f64) -> String {
     let s = if secs.is_finite() { secs.max(0.0) as u64 } else { 0 };
     format!("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+}
+
+impl Trainer {
+    /// Writes the checkpoint (model, EMA, optimiser, state), each through a temporary file
+    /// and the state last, so an interruption mid-write leaves the previous one usable.
+    pub(super) fn checkpoint(&mut self, wall_seconds: f64) -> anyhow::Result<()> {
+        self.state.wall_seconds = wall_seconds;
+        std::fs::create_dir_all(&self.paths.dir).with_context(|| format!("creating {}", self.paths.dir.display()))?;
+        let tmp = |p: &Path| p.with_extension("tmp.bpk");
+        let (model, ema, optim) = (self.paths.model(), self.paths.ema(), self.paths.optim());
+        self.net.clone().save_file(tmp(&model)).map_err(|e| anyhow!("writing {}: {e}", model.display()))?;
+        self.ema.clone().save_file(tmp(&ema)).map_err(|e| anyhow!("writing {}: {e}", ema.display()))?;
+        self.optim.save(tmp(&optim)).map_err(|e| anyhow!("writing {}: {e}", optim.display()))?;
+        let state_tmp = self.paths.state().with_extension("json.tmp");
+        std::fs::write(&state_tmp, serde_json::to_string_pretty(&self.state)?)
+            .with_context(|| format!("writing {}", state_tmp.display()))?;
+        for p in [&model, &ema, &optim] {
+            std::fs::rename(tmp(p), p).with_context(|| format!("moving {} into place", p.display()))?;
+        }
+        std::fs::rename(&state_tmp, self.paths.state())
+            .with_context(|| format!("writing {}", self.paths.state().display()))?;
+        Ok(())
+    }
 }

@@ -14,7 +14,7 @@ use std::sync::Arc;
 use serde::Deserialize;
 
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
-use crate::settings::{check_range, RangeError};
+use crate::range::{check_range, RangeError};
 use crate::tile::{Rect, Tile};
 
 pub use orographic::{upwind_pad, variability_pct, wind_vector};

@@ -16,7 +16,7 @@ use std::sync::Arc;
 use serde::Deserialize;
 
 use crate::infinite::Source;
-use crate::settings::{check_range, RangeError};
+use crate::range::{check_range, RangeError};
 use crate::tile::{Rect, Tile};
 
 /// Owner knobs of the continental layout (`[layout]` in `config/server.toml`).

@@ -5,7 +5,7 @@
 //! they live on, the 4× upsampling from model pixels to blocks. Must not touch: Minecraft (block ids, biomes,
 //! chunks) — callers map metres and climate to blocks themselves.
 
-pub mod stages;
+pub use crate::stages;
 
 use std::sync::Arc;
 
