@@ -6,11 +6,11 @@
 //! `infiniterra-terrain` crate, which knows nothing of Minecraft.
 
 pub mod biome;
+pub mod chunkgen;
 pub mod cli;
 pub mod config;
 pub mod draw;
 pub mod export;
-pub mod chunkgen;
 pub mod lab;
 pub mod npy;
 pub mod pregen;

@@ -234,7 +234,8 @@ fn repo() -> PathBuf {
 
 #[test]
 fn the_scanner_sees_grouped_and_super_imports_and_skips_comments() {
-    let code = code_only("use crate::{a, b::{c, d}};\n// crate::hidden\nlet s = \"crate::str\";\nsuper::x::y(); crate::e::f;");
+    let code =
+        code_only("use crate::{a, b::{c, d}};\n// crate::hidden\nlet s = \"crate::str\";\nsuper::x::y(); crate::e::f;");
     assert_eq!(names_after(&code, "crate::"), ["a", "b", "e"].map(String::from).into());
     assert_eq!(names_after(&code, "super::"), ["x"].map(String::from).into());
     let g: BTreeMap<String, BTreeSet<String>> =

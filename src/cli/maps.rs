@@ -6,9 +6,9 @@ use clap::Args;
 
 use super::progress::Progress;
 use super::{world_sources, Failure, Size, Sources};
+use crate::chunkgen::Generator;
 use crate::config::Config;
 use crate::export::{self, ExportRequest, Grid, Vertical};
-use crate::chunkgen::Generator;
 use crate::render::{self, Layer, RenderRequest};
 use crate::terrain::model_files::ModelFiles;
 use crate::terrain::Pipeline;

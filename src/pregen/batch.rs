@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 use super::plan::{Plan, Shard, Task};
 use super::progress::{self, Progress, State};
 use super::{run_to_end, Hooks, Job};
-use crate::config::Config;
 use crate::chunkgen::BiomePalette;
+use crate::config::Config;
 use crate::terrain::model_files::ModelFiles;
 use crate::world::{self, ChunkSource, OpenOptions, RulesSource, WorldError};
 

@@ -6,8 +6,8 @@ use std::sync::Arc;
 use valence::prelude::*;
 
 use crate::biome::BiomeRules;
-use crate::config::Config;
 use crate::chunkgen::{BiomePalette, Generator};
+use crate::config::Config;
 use crate::world::{RulesSource, Store};
 
 /// What start-up hands the app: configuration, generator and the biome rules.

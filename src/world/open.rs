@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::biome::{BiomeError, BiomeRules};
-use crate::config::{shipped, Config};
 use crate::chunkgen::{vanilla_biome_names, Generator};
+use crate::config::{shipped, Config};
 use crate::terrain::model_files::ModelFiles;
 use crate::terrain::pipeline::PipelineError;
 use crate::terrain::Pipeline;

@@ -11,10 +11,10 @@ use std::sync::Arc;
 #[allow(unused_imports)]
 pub use infiniterra::{
     biome::BiomeRules,
-    config::Config,
     chunkgen::{BiomePalette, Generator, SkyLight},
-    world::find_spawn,
+    config::Config,
     terrain::Pipeline,
+    world::find_spawn,
 };
 
 use super::repo;

@@ -8,8 +8,8 @@ use valence::prelude::{ChunkPos, ChunkView};
 
 use super::Measurement;
 use crate::biome::BiomeRules;
-use crate::config::Config;
 use crate::chunkgen::{BiomePalette, Generator, SkyLight};
+use crate::config::Config;
 use crate::pregen::{run_to_end, Hooks, Job, Plan, Shape, Shard, Task};
 use crate::terrain::Pipeline;
 use crate::world::codec::Encoder;

@@ -18,8 +18,8 @@ use valence::protocol::PacketEncoder;
 
 use super::Streamer;
 use crate::biome::BiomeRules;
-use crate::config::Config;
 use crate::chunkgen::Generator;
+use crate::config::Config;
 use crate::server::dimension::{self, WorldSetup};
 use crate::terrain::Pipeline;
 

@@ -12,8 +12,8 @@ use valence::registry::RegistryIdx;
 use super::nbt::{bit_width, packed_len};
 use super::*;
 use crate::biome::BiomeRules;
-use crate::config::Config;
 use crate::chunkgen::{BiomePalette, Generator, SkyLight};
+use crate::config::Config;
 use crate::terrain::Pipeline;
 
 const MIN_Y: i32 = -64;
