@@ -13,7 +13,7 @@
 //! chunk. Sky light is not a pass: the server and the world saver compute it from the
 //! finished blocks ([`SkyLight::of`]).
 //!
-//! Adding a pass (see docs/architecture.md, "Where to add a chunk-generation pass"): write
+//! Adding a pass (see docs/architecture.md, "Where to add: A chunk-generation pass"): write
 //! `passes/<name>.rs` with `pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk)` and
 //! its own unit tests, then add it to [`passes::PASSES`] at its place in the order (the list
 //! marks where carvers and ores go). A pass must stay a pure function of the context and the

@@ -1,5 +1,5 @@
 //! The lab: the tools that make and judge the learned terrain, kept apart from the product
-//! (docs/architecture.md, "The lab and the product").
+//! (docs/architecture.md, "The lab").
 //!
 //! - [`data`]: `infiniterra data fetch | prepare`, the real elevation data the models learn from;
 //! - [`eval`]: `infiniterra eval`, how realistic generated terrain is against real terrain;

@@ -5,7 +5,7 @@
 //! `engine.learned` accepts and which stages each needs (`settings`), how `Pipeline::build`
 //! chains them, what `infiniterra train STAGE` trains and ships, and the per-stage constants
 //! of the data preparation (`scripts/data/prepare.py`, checked against this table by a test).
-//! Adding a stage is one entry here (docs/architecture.md, "Adding a learned stage").
+//! Adding a stage is one entry here (docs/architecture.md, "Where to add: A learned stage").
 
 use crate::encoding::ContextSpec;
 

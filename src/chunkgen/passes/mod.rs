@@ -1,5 +1,5 @@
 //! The passes of chunk generation, in the one order they run (see docs/architecture.md,
-//! "Where to add a chunk-generation pass").
+//! "Where to add: A chunk-generation pass").
 //!
 //! Each pass has one job, reads the shared [`ChunkContext`] and writes into the chunk; later
 //! passes may overwrite what earlier ones wrote (the surface pass replaces the top of the
