@@ -39,10 +39,12 @@ fn assert_surveyed_columns(report: &Value, columns: &[(i64, i64)], generator: &G
         } else {
             assert_eq!(y, i64::from(v.water_top_y()), "sea surface at ({x}, {z}): {c}");
             assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
-            // One level less per block of water or ice.
+            // One level less per block of water or ice; the shallowest sea is one block deep,
+            // so the block below its surface is the (dark) sea floor.
             assert_eq!(c["sky_light_above"], 15, "{c}");
             assert_eq!(c["sky_light_at"], 14, "{c}");
-            assert_eq!(c["sky_light_below"], 13, "{c}");
+            let below = if s.y < v.water_top_y() - 1 { 13 } else { 0 };
+            assert_eq!(c["sky_light_below"], below, "{c}");
         }
     }
     land
