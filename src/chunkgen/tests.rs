@@ -7,37 +7,14 @@ use std::sync::Arc;
 
 use valence::prelude::{Biome, BiomeRegistry, BlockState, Chunk, Ident, UnloadedChunk};
 
+use super::passes::testing;
 use super::*;
 use crate::biome::BiomeRules;
 use crate::terrain::pipeline::channel;
 use crate::terrain::Rect;
 
-const RULES: &str = r#"
-fallback = "minecraft:plains"
-
-[[rule]]
-name = "sea"
-biome = "minecraft:ocean"
-elevation_m = [-inf, 0]
-override = true
-
-[[rule]]
-name = "high cold air"
-biome = "minecraft:snowy_plains"
-temperature_c = [-inf, -10]
-override = true
-
-[[rule]]
-name = "steep"
-biome = "minecraft:windswept_hills"
-slope_deg = [8, 90]
-"#;
-
 fn rules() -> BiomeRules {
-    match BiomeRules::from_sources(&[(PathBuf::from("test.toml"), RULES.to_string())]) {
-        Ok(rules) => rules,
-        Err(e) => panic!("test rules do not load: {e}"),
-    }
+    testing::rules()
 }
 
 fn palette() -> BiomePalette {
@@ -262,8 +239,7 @@ fn woodland_grows_trees_that_stand_on_the_ground() {
 }
 
 fn single_biome(biome: &str) -> BiomeRules {
-    let source = format!("fallback = \"minecraft:{biome}\"\n");
-    BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source)]).expect("single-biome rules")
+    testing::single_biome(&format!("minecraft:{biome}"))
 }
 
 /// `n` land chunks near the origin, well above the sea.

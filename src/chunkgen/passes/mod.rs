@@ -59,6 +59,33 @@ pub(crate) mod testing {
         Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), &config)
     }
 
+    /// The rule set of the generator's tests: sea, cold, dry and steep rules over a fallback.
+    pub fn rules() -> BiomeRules {
+        BiomeRules::from_sources(&[(PathBuf::from("test.toml"), RULES.to_string())]).expect("test rules load")
+    }
+
+    /// The text of [`rules`].
+    const RULES: &str = r#"
+fallback = "minecraft:plains"
+
+[[rule]]
+name = "sea"
+biome = "minecraft:ocean"
+elevation_m = [-inf, 0]
+override = true
+
+[[rule]]
+name = "high cold air"
+biome = "minecraft:snowy_plains"
+temperature_c = [-inf, -10]
+override = true
+
+[[rule]]
+name = "steep"
+biome = "minecraft:windswept_hills"
+slope_deg = [8, 90]
+"#;
+
     /// Rules that give every cell `biome`.
     pub fn single_biome(biome: &str) -> BiomeRules {
         let source = format!("fallback = \"{biome}\"\n");

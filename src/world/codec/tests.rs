@@ -1,7 +1,6 @@
 //! Codec tests: chunks survive encode → decode block by block and biome by biome, the bytes
 //! follow Anvil's packing rules, and every kind of damage is reported by name.
 
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -417,24 +416,7 @@ fn truncated_or_foreign_bytes_are_not_nbt() {
 }
 
 fn rules() -> BiomeRules {
-    let text = r#"
-fallback = "minecraft:plains"
-
-[[rule]]
-name = "sea"
-biome = "minecraft:ocean"
-elevation_m = [-inf, 0]
-override = true
-
-[[rule]]
-name = "steep"
-biome = "minecraft:windswept_hills"
-slope_deg = [8, 90]
-"#;
-    match BiomeRules::from_sources(&[(PathBuf::from("test.toml"), text.to_string())]) {
-        Ok(rules) => rules,
-        Err(e) => panic!("test rules do not load: {e}"),
-    }
+    crate::chunkgen::passes::testing::rules()
 }
 
 #[test]
