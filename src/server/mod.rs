@@ -67,9 +67,6 @@ pub struct Spawn(pub SpawnPoint);
 
 /// Runs the server until `stop` on the console, Ctrl-C or SIGTERM.
 pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> {
-    // Bad rules are the owner's to fix: say so before anything touches the network.
-    options.rules.load()?;
-
     let address = config.bind_address();
     if address.port() == 0 {
         return Err(ServeError::Input(anyhow::anyhow!(
@@ -84,6 +81,8 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
         );
     }
 
+    // `world::open` loads and checks the rules first, before the pipeline is built and
+    // before the network starts: bad rules are reported at once.
     let open = OpenOptions {
         rules: options.rules.clone(),
         models: options.models.clone(),
