@@ -4,13 +4,10 @@
 //! Every value depends only on global coordinates (the pipeline is seed-consistent), so two
 //! chunks that share a border compute identical numbers for it.
 
-use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
+use crate::terrain::pipeline::channel;
 use crate::terrain::{Pipeline, Rect, Tile};
 
 use super::Vertical;
-
-/// Horizontal size of one block column, metres.
-pub const BLOCK_METRES: f64 = MODEL_PIXEL_METRES / BLOCKS_PER_MODEL_PIXEL as f64;
 
 /// The pipeline's answer for a rectangle of block columns, with each column's surface Y.
 pub struct Columns {
@@ -56,12 +53,11 @@ impl Columns {
         self.surface[self.index(x, z)]
     }
 
-    /// Physical slope of the ground, degrees, from central differences of elevation over the
-    /// four neighbours (which must be inside the rectangle).
+    /// Steepness of the land around the column, degrees: the smooth relief's slope (see
+    /// [`channel::RELIEF_SLOPE`]), the same at any world scale. The faces a player sees are
+    /// [`Columns::drop_blocks`].
     pub fn slope_deg(&self, x: i64, z: i64) -> f32 {
-        let dx = f64::from(self.elevation(x + 1, z) - self.elevation(x - 1, z)) / (2.0 * BLOCK_METRES);
-        let dz = f64::from(self.elevation(x, z + 1) - self.elevation(x, z - 1)) / (2.0 * BLOCK_METRES);
-        dx.hypot(dz).atan().to_degrees() as f32
+        self.get(channel::RELIEF_SLOPE, x, z)
     }
 
     /// How many blocks the ground falls from this column to its lowest 4-neighbour (0 when no
@@ -92,11 +88,10 @@ mod tests {
     }
 
     #[test]
-    fn slope_of_a_plane_matches_its_gradient() {
+    fn drops_count_the_blocks_to_the_lowest_neighbour() {
         let v = Vertical::from_world(&crate::config::WorldSettings::default());
-        // Rises 125 m per block east: a 45° slope.
+        // Rises 125 m per block east.
         let cols = Columns::from_tile(tile_with_elevation(Rect::new(0, 0, 3, 3), |x, _| x as f32 * 125.0), &v);
-        assert!((cols.slope_deg(1, 1) - 45.0).abs() < 1e-3);
         assert_eq!(cols.drop_blocks(1, 1), 5, "125 m = 5 blocks of 25 m");
         let flat = Columns::from_tile(tile_with_elevation(Rect::new(0, 0, 3, 3), |_, _| 300.0), &v);
         assert_eq!((flat.slope_deg(1, 1), flat.drop_blocks(1, 1)), (0.0, 0));

@@ -45,7 +45,7 @@ use crate::config::Config;
 use crate::terrain::Pipeline;
 
 pub use chunk::{PassTiming, CHUNK};
-pub use columns::{Columns, BLOCK_METRES};
+pub use columns::Columns;
 pub use context::ChunkContext;
 pub use light::SkyLight;
 pub use palette::{vanilla_biome_names, BiomePalette};

@@ -28,8 +28,8 @@ impl Vertical {
             sea_level_y: world.sea_level_y as i32,
             min_y: world.min_y as i32,
             height: world.height as i32,
-            metres_per_block: world.metres_per_block,
-            sea_metres_per_block: world.sea_metres_per_block,
+            metres_per_block: world.vertical_metres_per_block,
+            sea_metres_per_block: world.sea_vertical_metres_per_block,
         }
     }
 

@@ -59,7 +59,7 @@ pub struct EvalArgs {
     /// Report image (slope histograms and power spectra).
     #[arg(long, default_value = "eval_report.png")]
     pub out: PathBuf,
-    /// Window stride of the generator in model pixels: seams are measured on lines this far
+    /// Window stride of the generator in 500 m pixels: seams are measured on lines this far
     /// apart (32 = the pipeline's window stride).
     #[arg(long, default_value_t = 32)]
     pub seam_stride: usize,

@@ -113,8 +113,10 @@ pub fn export(config: &Config, sources: &Sources, a: &ExportArgs) -> Result<(), 
         height: a.area.size.height,
         grid: a.grid,
     };
-    let vertical =
-        Vertical { sea_level_y: config.world.sea_level_y as i32, metres_per_block: config.world.metres_per_block };
+    let vertical = Vertical {
+        sea_level_y: config.world.sea_level_y as i32,
+        metres_per_block: config.world.vertical_metres_per_block,
+    };
     let (_, models) = world_sources(config, sources, None);
     let pipeline = pipeline(config, &models)?;
     let mut progress = Progress::new("export", "rows");

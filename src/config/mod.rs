@@ -103,10 +103,13 @@ pub struct WorldSettings {
     pub min_y: i64,
     /// Height of the world in blocks (multiple of 16).
     pub height: i64,
-    /// Metres of real elevation per block above the sea (the vertical scale, chosen for looks).
+    /// Horizontal size of one block column, metres: the world's scale (15 … 250). A saved
+    /// world keeps the scale it was made with.
     pub metres_per_block: f64,
+    /// Metres of real elevation per block above the sea (the vertical scale, chosen for looks).
+    pub vertical_metres_per_block: f64,
     /// Metres of depth per block under the sea (the sea floor is compressed).
-    pub sea_metres_per_block: f64,
+    pub sea_vertical_metres_per_block: f64,
     /// Folder of the saved world (`level.dat`, `region/r.X.Z.mca`), relative to the current
     /// directory unless absolute.
     pub directory: PathBuf,
@@ -121,8 +124,9 @@ impl Default for WorldSettings {
             sea_level_y: 63,
             min_y: -64,
             height: 384,
-            metres_per_block: 25.0,
-            sea_metres_per_block: 60.0,
+            metres_per_block: crate::terrain::settings::DEFAULT_METRES_PER_BLOCK,
+            vertical_metres_per_block: 25.0,
+            sea_vertical_metres_per_block: 60.0,
             directory: PathBuf::from("world"),
             save_chunks: true,
         }
@@ -170,7 +174,12 @@ impl Config {
 
     /// The terrain side's settings.
     pub fn terrain(&self) -> TerrainSettings {
-        TerrainSettings { layout: self.layout.clone(), climate: self.climate.clone(), engine: self.engine.clone() }
+        TerrainSettings {
+            metres_per_block: self.world.metres_per_block,
+            layout: self.layout.clone(),
+            climate: self.climate.clone(),
+            engine: self.engine.clone(),
+        }
     }
 
     /// The address to listen on (validated at load).
@@ -195,8 +204,8 @@ impl Config {
         check_range("world.min_y", w.min_y, -2032, 2016)?;
         check_range("world.height", w.height, 16, 4064)?;
         check_range("world.sea_level_y", w.sea_level_y, w.min_y + 1, w.min_y + w.height - 2)?;
-        check_range("world.metres_per_block", w.metres_per_block, 1.0, 1000.0)?;
-        check_range("world.sea_metres_per_block", w.sea_metres_per_block, 1.0, 5000.0)?;
+        check_range("world.vertical_metres_per_block", w.vertical_metres_per_block, 1.0, 1000.0)?;
+        check_range("world.sea_vertical_metres_per_block", w.sea_vertical_metres_per_block, 1.0, 5000.0)?;
         for (key, v) in [("world.min_y", w.min_y), ("world.height", w.height)] {
             if v.rem_euclid(16) != 0 {
                 return Err(RangeError { key: key.into(), value: v.to_string(), allowed: "a multiple of 16".into() });

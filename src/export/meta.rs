@@ -10,13 +10,13 @@ use serde::{Deserialize, Serialize};
 
 use super::ExportError;
 use crate::npy::tmp_path;
-use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
+use crate::terrain::pipeline::BLOCKS_PER_MODEL_PIXEL;
 
 /// Which grid an export samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Grid {
-    /// One value per block column (bilinearly upsampled, what the world is built from).
+    /// One value per block column (upsampled and carved: what the world is built from).
     Block,
     /// One value per model pixel (the upsampling's source, what the models produce).
     Model,
@@ -39,9 +39,9 @@ impl Grid {
         }
     }
 
-    /// Horizontal size of one array cell, metres.
-    pub fn metres_per_pixel(self) -> f64 {
-        MODEL_PIXEL_METRES * self.blocks_per_cell() as f64 / BLOCKS_PER_MODEL_PIXEL as f64
+    /// Horizontal size of one array cell in a world of `block_metres` blocks, metres.
+    pub fn metres_per_pixel(self, block_metres: f64) -> f64 {
+        block_metres * self.blocks_per_cell() as f64
     }
 }
 
@@ -152,8 +152,8 @@ mod tests {
 
     #[test]
     fn metres_per_pixel_follow_the_grid() {
-        assert_eq!(Grid::Block.metres_per_pixel(), MODEL_PIXEL_METRES / 4.0);
-        assert_eq!(Grid::Model.metres_per_pixel(), MODEL_PIXEL_METRES);
+        assert_eq!(Grid::Block.metres_per_pixel(40.0), 40.0);
+        assert_eq!(Grid::Model.metres_per_pixel(40.0), 160.0);
     }
 
     #[test]

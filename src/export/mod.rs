@@ -150,7 +150,7 @@ pub fn export(
         width: rect.w as usize,
         height: rect.h as usize,
         grid: req.grid,
-        metres_per_pixel: req.grid.metres_per_pixel(),
+        metres_per_pixel: req.grid.metres_per_pixel(pipeline.block_metres()),
         seed: pipeline.seed(),
         stages: pipeline.active_stages(),
         vertical: *vertical,

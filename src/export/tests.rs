@@ -85,7 +85,7 @@ fn model_grid_export_equals_the_pipeline_model() {
     let meta = ExportMeta::read(&summary.json).unwrap();
     assert_eq!((meta.x0, meta.z0, meta.width, meta.height), (-40, 20, 14, 8));
     assert_eq!(meta.grid, Grid::Model);
-    assert_eq!(meta.metres_per_pixel, crate::terrain::pipeline::MODEL_PIXEL_METRES);
+    assert_eq!(meta.metres_per_pixel, 4.0 * crate::terrain::settings::DEFAULT_METRES_PER_BLOCK);
 }
 
 #[test]
@@ -111,7 +111,7 @@ fn json_sidecar_has_every_field() {
     assert_eq!(v["width"], 50);
     assert_eq!(v["height"], 30);
     assert_eq!(v["grid"], "block");
-    assert_eq!(v["metres_per_pixel"], crate::terrain::pipeline::MODEL_PIXEL_METRES / 4.0);
+    assert_eq!(v["metres_per_pixel"], crate::terrain::settings::DEFAULT_METRES_PER_BLOCK);
     assert_eq!(v["seed"], 42);
     assert_eq!(v["stages"], serde_json::json!(pipeline.active_stages()));
     assert_eq!(v["vertical"]["sea_level_y"], 63);

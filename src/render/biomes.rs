@@ -96,7 +96,7 @@ pub fn render_biomes(
         progress(py as u64 + 1, height as u64);
     }
     let pipeline = generator.pipeline();
-    Ok(frame(map, &title_lines(req, pipeline.seed(), &pipeline.active_stages()), counts))
+    Ok(frame(map, &title_lines(req, pipeline.seed(), &pipeline.active_stages(), pipeline.block_metres()), counts))
 }
 
 /// The map above a panel with the title and one swatch per biome, most common first.

@@ -19,7 +19,7 @@ use image::{Rgb, RgbImage};
 pub use biomes::render_biomes;
 pub use layer::{Layer, UnknownLayer};
 
-use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
+use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL};
 use crate::terrain::tile::div_ceil;
 use crate::terrain::{Pipeline, Rect, Tile};
 use sample::{CellGrid, Geometry, Samples};
@@ -122,7 +122,7 @@ pub fn render(
 ) -> Result<RgbImage, RenderError> {
     let style = layer::style(req.layer).ok_or(RenderError::BiomeNeedsRules)?;
     let size = check(req)?;
-    let title = title_lines(req, pipeline.seed(), &pipeline.active_stages());
+    let title = title_lines(req, pipeline.seed(), &pipeline.active_stages(), pipeline.block_metres());
     // Below 4 blocks per pixel the map resolves single blocks, so it reads the upsampled
     // block grid the world is built from; from 4 up it reads model pixels directly, which is
     // exact at zoom 4 and avoids upsampling work that sampling would throw away.
@@ -136,7 +136,7 @@ pub fn render(
             (false, true) => (CellGrid::MODEL, Box::new(|r| pipeline.elevation(r))),
             (false, false) => (CellGrid::MODEL, Box::new(|r| pipeline.model(r))),
         };
-    Ok(draw(req, size, &style, &title, grid, &mut *query, progress))
+    Ok(draw(req, size, &style, &title, (grid, pipeline.block_metres()), &mut *query, progress))
 }
 
 /// Writes `img` as a PNG at `path`, atomically: a reader never sees a half-written map.
@@ -147,11 +147,6 @@ pub fn save_png(img: &RgbImage, path: &Path) -> Result<(), RenderError> {
     let tmp = PathBuf::from(tmp);
     img.save_with_format(&tmp, image::ImageFormat::Png).map_err(err)?;
     std::fs::rename(&tmp, path).map_err(|e| err(image::ImageError::IoError(e)))
-}
-
-/// Horizontal size of one block, metres.
-pub(crate) fn block_metres() -> f64 {
-    MODEL_PIXEL_METRES / BLOCKS_PER_MODEL_PIXEL as f64
 }
 
 /// Validates the request; returns the map's size in pixels.
@@ -184,7 +179,7 @@ pub(crate) fn check(req: &RenderRequest) -> Result<(u32, u32), RenderError> {
     Ok((w as u32, h as u32))
 }
 
-pub(crate) fn title_lines(req: &RenderRequest, seed: u64, stages: &[String]) -> Vec<String> {
+pub(crate) fn title_lines(req: &RenderRequest, seed: u64, stages: &[String], block_metres: f64) -> Vec<String> {
     let stages = if stages.is_empty() { "none".to_string() } else { stages.join(", ") };
     vec![
         format!("{} - seed {} - stages: {}", req.layer, seed, stages),
@@ -197,7 +192,7 @@ pub(crate) fn title_lines(req: &RenderRequest, seed: u64, stages: &[String]) -> 
             req.width,
             req.height
         ),
-        format!("zoom {} blocks/px = {}/px", req.zoom, distance(req.zoom as f64 * block_metres())),
+        format!("zoom {} blocks/px = {}/px", req.zoom, distance(req.zoom as f64 * block_metres)),
     ]
 }
 
@@ -223,13 +218,14 @@ fn strip_rows(width_px: u32, zoom: i64) -> i64 {
     (4_000_000 / ((width_px as i64 + 2) * cells_per_px)).clamp(16, MAX_STRIP_ROWS)
 }
 
-/// Draws map and panel from cells fetched through `query` on `grid`.
+/// Draws map and panel from cells fetched through `query` on `grid` (blocks of
+/// `block_metres`).
 fn draw(
     req: &RenderRequest,
     (width, height): (u32, u32),
     style: &layer::Style,
     title: &[String],
-    grid: CellGrid,
+    (grid, block_metres): (CellGrid, f64),
     query: &mut dyn FnMut(Rect) -> Tile,
     progress: &mut dyn FnMut(u64, u64),
 ) -> RgbImage {
@@ -238,7 +234,7 @@ fn draw(
     let mut img = RgbImage::from_pixel(frame_width, height + panel::height(scale), panel::BACKGROUND);
 
     let geometry = Geometry { x0: req.x0, z0: req.z0, zoom: req.zoom };
-    let metres_per_px = req.zoom as f64 * block_metres();
+    let metres_per_px = req.zoom as f64 * block_metres;
     let shading = Shading { spacing: metres_per_px as f32, exaggeration: shade::exaggeration(metres_per_px) };
     let channels = [channel::ELEVATION, style.channel];
     let rows_per_strip = strip_rows(width, req.zoom);
@@ -258,7 +254,7 @@ fn draw(
         progress(top as u64, h as u64);
     }
 
-    panel::draw(&mut img, height, title, &style.legend, metres_per_px, scale);
+    panel::draw(&mut img, height, title, &style.legend, (metres_per_px, block_metres), scale);
     img
 }
 

@@ -58,7 +58,14 @@ pub(crate) fn height(scale: u32) -> u32 {
 }
 
 /// Draws the panel into the rows of `img` from `top` down.
-pub(crate) fn draw(img: &mut RgbImage, top: u32, title: &[String], legend: &Legend, metres_per_px: f64, scale: u32) {
+pub(crate) fn draw(
+    img: &mut RgbImage,
+    top: u32,
+    title: &[String],
+    legend: &Legend,
+    (metres_per_px, block_metres): (f64, f64),
+    scale: u32,
+) {
     let width = img.width();
     draw::fill(img, 0, top as i64, width, img.height() - top, BACKGROUND);
     let s = scale as i64;
@@ -71,7 +78,7 @@ pub(crate) fn draw(img: &mut RgbImage, top: u32, title: &[String], legend: &Lege
     y += margin;
     y = draw_legend(img, margin, y, legend, scale);
     y += margin;
-    draw_scale_bar(img, margin, y, metres_per_px, scale);
+    draw_scale_bar(img, margin, y, (metres_per_px, block_metres), scale);
 }
 
 /// Draws the legend at (`x`, `y`); returns the y below it.
@@ -108,9 +115,8 @@ fn draw_legend(img: &mut RgbImage, x: i64, y: i64, legend: &Legend, scale: u32) 
 
 /// Draws a scale bar at (`x`, `y`) about a quarter of the frame wide, labelled in blocks and
 /// kilometres.
-fn draw_scale_bar(img: &mut RgbImage, x: i64, y: i64, metres_per_px: f64, scale: u32) {
+fn draw_scale_bar(img: &mut RgbImage, x: i64, y: i64, (metres_per_px, block_metres): (f64, f64), scale: u32) {
     let s = scale as i64;
-    let block_metres = super::block_metres();
     let target_px = (img.width() as f64 / 4.0).min(300.0 * scale as f64);
     let km = nice_length_km(target_px * metres_per_px / 1000.0);
     let px = ((km * 1000.0 / metres_per_px).round() as i64).max(1);
@@ -183,7 +189,7 @@ mod tests {
             ticks: &[0.0, 0.5, 1.0],
         };
         let mut img = RgbImage::from_pixel(MIN_FRAME_WIDTH, 10 + height(1), Rgb([1, 2, 3]));
-        draw(&mut img, 10, &["line".to_string()], &legend, 125.0, 1);
+        draw(&mut img, 10, &["line".to_string()], &legend, (125.0, 125.0), 1);
         assert_eq!(*img.get_pixel(0, 9), Rgb([1, 2, 3]), "rows above the panel are untouched");
         assert!(img.enumerate_pixels().filter(|(_, y, _)| *y >= 10).all(|(_, _, p)| *p != Rgb([1, 2, 3])));
         let reddish = img.pixels().filter(|p| p[0] > 200 && p[2] < 50).count();

@@ -32,10 +32,10 @@ fn field(rect: Rect) -> Tile {
 fn draw_synthetic(req: &RenderRequest) -> (RgbImage, Vec<(u64, u64)>) {
     let style = layer::style(req.layer).unwrap();
     let size = check(req).unwrap();
-    let title = title_lines(req, 7, &["layout".to_string()]);
+    let title = title_lines(req, 7, &["layout".to_string()], 40.0);
     let grid = if req.zoom < 4 { CellGrid::BLOCKS } else { CellGrid::MODEL };
     let mut calls = Vec::new();
-    let img = draw(req, size, &style, &title, grid, &mut field, &mut |d, t| calls.push((d, t)));
+    let img = draw(req, size, &style, &title, (grid, 40.0), &mut field, &mut |d, t| calls.push((d, t)));
     (img, calls)
 }
 
@@ -165,7 +165,8 @@ fn save_png_writes_a_readable_file() {
 
 #[test]
 fn title_says_what_where_and_how_big() {
-    let lines = title_lines(&RenderRequest { zoom: 256, ..request(Layer::Precipitation) }, 42, &["layout".into()]);
+    let lines =
+        title_lines(&RenderRequest { zoom: 256, ..request(Layer::Precipitation) }, 42, &["layout".into()], 125.0);
     assert_eq!(lines.len(), panel::TITLE_LINES);
     assert_eq!(lines[0], "precipitation - seed 42 - stages: layout");
     assert_eq!(lines[1], "x -64..64, z 32..160 (128×128 blocks)");

@@ -34,7 +34,14 @@ pub struct LevelInfo {
     pub spawn: [i32; 3],
     /// `DataVersion`: the Minecraft version that saved it last.
     pub data_version: i32,
+    /// The world's horizontal scale, metres per block (`infiniterra.metres_per_block`; worlds
+    /// saved before the scale was configurable were [`LEGACY_METRES_PER_BLOCK`]).
+    pub metres_per_block: f64,
 }
+
+/// The scale of worlds whose `level.dat` records none: every world saved before
+/// `world.metres_per_block` existed was 125 m per block.
+pub const LEGACY_METRES_PER_BLOCK: f64 = 125.0;
 
 /// Why `level.dat` could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -54,9 +61,18 @@ pub enum LevelError {
 /// fsync, rename) so that Minecraft 1.20.1 and world tools open the world: version fields,
 /// `LevelName` `name`, the spawn point, `WorldGenSettings` with `seed` and the void
 /// superflat overworld (see the module documentation), `GameType` `game_type` (0 survival,
-/// 1 creative, 2 adventure, 3 spectator), commands allowed, noon.
-pub fn write_level_dat(dir: &Path, name: &str, seed: u64, spawn: [i32; 3], game_type: i32) -> io::Result<()> {
-    let root = compound! { "Data" => level_data(name, seed, spawn, game_type) };
+/// 1 creative, 2 adventure, 3 spectator), commands allowed, noon; and our own
+/// `infiniterra.metres_per_block`, the scale the world's chunks were made at.
+pub fn write_level_dat(
+    dir: &Path,
+    name: &str,
+    (seed, metres_per_block): (u64, f64),
+    spawn: [i32; 3],
+    game_type: i32,
+) -> io::Result<()> {
+    let mut data = level_data(name, seed, spawn, game_type);
+    data.insert("infiniterra", compound! { "metres_per_block" => metres_per_block });
+    let root = compound! { "Data" => data };
     let mut gz = GzEncoder::new(Vec::new(), Compression::default());
     root.to_binary(&mut gz, "").map_err(io::Error::other)?;
     let bytes = gz.finish()?;
@@ -99,11 +115,19 @@ pub fn read_level_dat(dir: &Path) -> Result<LevelInfo, LevelError> {
         },
         _ => return Err(LevelError::Missing("WorldGenSettings")),
     };
+    let metres_per_block = match data.get("infiniterra") {
+        Some(Value::Compound(ours)) => match ours.get("metres_per_block") {
+            Some(Value::Double(m)) => *m,
+            _ => return Err(LevelError::Missing("infiniterra.metres_per_block")),
+        },
+        _ => LEGACY_METRES_PER_BLOCK,
+    };
     Ok(LevelInfo {
         name,
         seed,
         spawn: [int("SpawnX")?, int("SpawnY")?, int("SpawnZ")?],
         data_version: int("DataVersion")?,
+        metres_per_block,
     })
 }
 
@@ -202,22 +226,39 @@ mod tests {
             Err(e) => panic!("no temporary directory: {e}"),
         };
         let seed = 0xDEAD_BEEF_0123_4567u64; // High bit set: stored as a negative long.
-        if let Err(e) = write_level_dat(dir.path(), "Terra ñ", seed, [12, 80, -300], 1) {
+        if let Err(e) = write_level_dat(dir.path(), "Terra ñ", (seed, 37.5), [12, 80, -300], 1) {
             panic!("write failed: {e}");
         }
         assert!(!dir.path().join("level.dat.tmp").exists());
         match read_level_dat(dir.path()) {
             Ok(info) => assert_eq!(
                 info,
-                LevelInfo { name: "Terra ñ".into(), seed, spawn: [12, 80, -300], data_version: DATA_VERSION }
+                LevelInfo {
+                    name: "Terra ñ".into(),
+                    seed,
+                    spawn: [12, 80, -300],
+                    data_version: DATA_VERSION,
+                    metres_per_block: 37.5
+                }
             ),
             Err(e) => panic!("read failed: {e}"),
         }
         // Written again over itself (as after a crash), still one readable file.
-        if let Err(e) = write_level_dat(dir.path(), "again", 7, [0, 64, 0], 0) {
+        if let Err(e) = write_level_dat(dir.path(), "again", (7, 40.0), [0, 64, 0], 0) {
             panic!("rewrite failed: {e}");
         }
         assert!(matches!(read_level_dat(dir.path()), Ok(LevelInfo { seed: 7, .. })));
+    }
+
+    #[test]
+    fn a_level_dat_without_a_scale_is_the_old_fixed_scale() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let root = compound! { "Data" => level_data("old", 3, [0, 64, 0], 1) };
+        let mut gz = GzEncoder::new(Vec::new(), Compression::default());
+        root.to_binary(&mut gz, "").expect("encodes");
+        fs::write(dir.path().join("level.dat"), gz.finish().expect("compresses")).expect("writes");
+        let info = read_level_dat(dir.path()).expect("reads");
+        assert_eq!((info.seed, info.metres_per_block), (3, LEGACY_METRES_PER_BLOCK));
     }
 
     #[test]

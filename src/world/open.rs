@@ -150,7 +150,8 @@ pub fn open(config: &Config, options: &OpenOptions, tell: &mut dyn FnMut(Opening
     let directory = options.directory.clone().unwrap_or_else(|| config.world.directory.clone());
     let store = if options.save {
         let at = [spawn.block.x, spawn.block.y, spawn.block.z];
-        super::prepare(&directory, seed, at, config.server.gamemode.game_type())
+        let identity = (seed, config.world.metres_per_block);
+        super::prepare(&directory, identity, at, config.server.gamemode.game_type())
             .map_err(|e| WorldError::Folder(format!("{e:#}")))?;
         let store = Store::open(&directory).map_err(WorldError::Store)?;
         tell(Opening::Saving(&directory));

@@ -4,13 +4,14 @@ use valence::prelude::{BlockPos, BlockState, DVec3};
 
 use crate::biome::BiomeRules;
 use crate::chunkgen::{Columns, Generator, CHUNK};
-use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, COARSE_FACTOR};
 use crate::terrain::Rect;
 
 /// Coarse cells that look like land above this elevation are searched, metres (a margin above
 /// the shore, where the exact surface may still dip under the sea).
 const LAND_M: f32 = 20.0;
-/// Rings of coarse cells searched around the origin before giving up (≈ 12,800 blocks).
+/// Side of the squares searched, blocks (a coarse elevation sample each).
+const CELL: i64 = 64;
+/// Rings of squares searched around the origin before giving up (12,800 blocks).
 const MAX_RINGS: i64 = 200;
 /// Ground that falls this many blocks to a neighbour is a cliff, not a spawn.
 const MAX_DROP: i32 = 1;
@@ -28,7 +29,7 @@ pub struct SpawnPoint {
 /// picks the walkable column nearest that coarse cell's centre. Runs once at start-up.
 pub fn find_spawn(generator: &Generator, rules: &BiomeRules) -> SpawnPoint {
     let pipeline = generator.pipeline();
-    let cell = BLOCKS_PER_MODEL_PIXEL * COARSE_FACTOR;
+    let cell = CELL;
     for ring in 0..=MAX_RINGS {
         let mut candidates: Vec<(i64, i64)> = ring_cells(ring)
             .filter(|&(cx, cz)| pipeline.coarse_elevation_at_block(cx * cell + cell / 2, cz * cell + cell / 2) > LAND_M)

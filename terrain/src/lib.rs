@@ -6,6 +6,7 @@
 
 pub mod climate;
 pub mod encoding;
+pub mod erosion;
 pub mod infinite;
 pub mod layout;
 pub mod metrics;
@@ -15,6 +16,7 @@ pub mod model_files;
 pub mod noise;
 pub mod pipeline;
 pub mod range;
+pub mod resample;
 pub mod settings;
 pub mod stages;
 pub mod tile;

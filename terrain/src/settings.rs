@@ -187,10 +187,18 @@ impl EngineSettings {
     }
 }
 
+/// Horizontal size of a block column by default, metres (`world.metres_per_block`).
+pub const DEFAULT_METRES_PER_BLOCK: f64 = 125.0;
+/// The horizontal scales a world may have, metres per block.
+pub const METRES_PER_BLOCK_RANGE: (f64, f64) = (15.0, 250.0);
+
 /// Everything the terrain pipeline needs besides the seed.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TerrainSettings {
+    /// Horizontal size of one block column, metres: the world's scale. The pipeline's finest
+    /// grid is always 4 blocks, whatever the scale.
+    pub metres_per_block: f64,
     /// The procedural continental layout.
     pub layout: LayoutSettings,
     /// The climate model.
@@ -199,9 +207,27 @@ pub struct TerrainSettings {
     pub engine: EngineSettings,
 }
 
+impl Default for TerrainSettings {
+    fn default() -> Self {
+        TerrainSettings {
+            metres_per_block: DEFAULT_METRES_PER_BLOCK,
+            layout: LayoutSettings::default(),
+            climate: ClimateSettings::default(),
+            engine: EngineSettings::default(),
+        }
+    }
+}
+
 impl TerrainSettings {
+    /// Size of a model pixel (always 4 blocks), metres.
+    pub fn model_pixel_metres(&self) -> f64 {
+        self.metres_per_block * crate::pipeline::BLOCKS_PER_MODEL_PIXEL as f64
+    }
+
     /// Checks every value against its range.
     pub fn validate(&self) -> Result<(), RangeError> {
+        let (lo, hi) = METRES_PER_BLOCK_RANGE;
+        check_range("world.metres_per_block", self.metres_per_block, lo, hi)?;
         self.layout.validate()?;
         self.climate.validate()?;
         self.engine.validate()

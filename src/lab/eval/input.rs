@@ -10,7 +10,7 @@ use super::EvalError;
 use crate::export::{ExportMeta, Grid};
 use crate::npy::read_npy_f32;
 use crate::terrain::metrics::Raster;
-use crate::terrain::pipeline::{BLOCKS_PER_MODEL_PIXEL, MODEL_PIXEL_METRES};
+use crate::terrain::pipeline::{BASE_METRES, BLOCKS_PER_MODEL_PIXEL};
 
 /// Tile side when neither file says (the prepared sets' size).
 pub const DEFAULT_TILE: usize = 256;
@@ -103,8 +103,9 @@ pub struct Heightmap {
     pub tile: Option<usize>,
     /// Global pixel coordinates (x, y) of the first pixel on this file's own grid, when known.
     pub origin: Option<(i64, i64)>,
-    /// Array pixels per model pixel along each axis (1 on the model grid, 4 on the block grid).
-    pub pixels_per_model_pixel: f64,
+    /// Array pixels per 500 m base pixel (the grid the learned windows' strides are counted
+    /// on) along each axis.
+    pub pixels_per_base_pixel: f64,
     /// `Some(n)`: the tiles are generated counterparts of the first `n` held-out tiles of a
     /// prepared set (`train <stage> --generate-heldout`), so they are compared with those.
     pub heldout_counterparts: Option<usize>,
@@ -150,7 +151,7 @@ impl Heightmap {
             tile: side.tile,
             origin,
             // From the resolution, so a prepared stack (no grid) is handled like an export.
-            pixels_per_model_pixel: MODEL_PIXEL_METRES / side.metres_per_pixel,
+            pixels_per_base_pixel: BASE_METRES / side.metres_per_pixel,
             heldout_counterparts: side.heldout_counterparts,
         })
     }

@@ -19,7 +19,7 @@ pub use input::{Heightmap, Reference};
 pub use report::{BetaSplits, Report, Target, SPECTRAL_SLOPE_KEY};
 
 use crate::terrain::metrics::{fbm, Raster, SeamLines, FBM_BETA};
-use crate::terrain::pipeline::MODEL_PIXEL_METRES;
+use crate::terrain::pipeline::BASE_METRES;
 use report::Column;
 
 /// Seed of the fBm baseline: fixed, so every report compares against the same noise.
@@ -36,7 +36,7 @@ pub struct EvalOptions {
     pub reference: PathBuf,
     /// Report image (slope histograms and power spectra).
     pub out: PathBuf,
-    /// Window stride of the generator in model pixels: seams are measured on lines this far
+    /// Window stride of the generator in 500 m pixels: seams are measured on lines this far
     /// apart (32 = the pipeline's window stride).
     pub seam_stride: usize,
     /// Model manifest (e.g. `models/core.json`) whose `realism` numbers are replaced by this
@@ -121,7 +121,7 @@ pub fn run(args: &EvalOptions, progress: &mut dyn FnMut(u64, u64)) -> Result<Rep
     // Seams are a property of the generator's grid: measure them at its native resolution on
     // its own window lines; the other columns show the same statistic on lines the same
     // distance apart, which is what "no seams" looks like.
-    let stride_metres = args.seam_stride as f64 * MODEL_PIXEL_METRES;
+    let stride_metres = args.seam_stride as f64 * BASE_METRES;
     let ref_lines = SeamLines::for_origin(((stride_metres / metres).round() as usize).max(2), 0, 0);
     let total = (gen_tiles.len() * 2 + ref_tiles.len() + train_tiles.len()) as u64;
     let mut done = 0;
@@ -188,7 +188,7 @@ fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
 /// The generated map's seam sums on its own window lines (whole map: its origin places the
 /// lines; a stack of tiles: lines from each tile's corner).
 fn native_seams(generated: &Heightmap, stride_model_px: usize) -> crate::terrain::metrics::SeamStats {
-    let stride = ((stride_model_px as f64 * generated.pixels_per_model_pixel).round() as usize).max(2);
+    let stride = ((stride_model_px as f64 * generated.pixels_per_base_pixel).round() as usize).max(2);
     let (x0, y0) = match (generated.tile, generated.origin) {
         (None, Some(origin)) => origin,
         _ => (0, 0),

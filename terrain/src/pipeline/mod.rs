@@ -2,8 +2,13 @@
 //! every block column of this rectangle".
 //!
 //! Owns: the stage list (coarse → core → detail, as data in [`stages::LEARNED`]), the grids
-//! they live on, the 4× upsampling from model pixels to blocks. Must not touch: Minecraft (block ids, biomes,
-//! chunks) — callers map metres and climate to blocks themselves.
+//! they live on, the world's horizontal scale, the model grid (always 4 blocks: the finest
+//! learned grid resampled to it, plus the erosion filter's longer octaves) and the 4×
+//! upsampling from model pixels to blocks (plus the erosion filter's two shortest octaves).
+//! Must not touch: Minecraft (block ids, biomes, chunks) — callers map metres and climate to
+//! blocks themselves.
+
+mod finest;
 
 pub use crate::stages;
 
@@ -13,19 +18,25 @@ pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 
 use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
+use crate::erosion::{octaves_between, ErosionFilter};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
+use crate::resample;
 use crate::settings::{StageName, TerrainSettings};
 use crate::tile::{Rect, Tile};
-use crate::upsample;
+use finest::Finest;
 
-/// Minecraft blocks per model pixel (horizontally), whatever the model's real resolution.
+/// Minecraft blocks per model pixel (horizontally), whatever the world's scale: the model
+/// grid is always 4 blocks.
 pub const BLOCKS_PER_MODEL_PIXEL: i64 = 4;
-/// Real size of one model pixel, metres (the final stage's training resolution).
-pub const MODEL_PIXEL_METRES: f64 = 500.0;
-/// Model pixels per coarse pixel (the coarse grid: continents, shelves, climate).
-pub const COARSE_FACTOR: i64 = 16;
+/// The finest grid a stage is trained on, metres: the layout's and the `detail` stage's
+/// (the learned windows' seams are measured on it).
+pub const BASE_METRES: f64 = 500.0;
+/// The coarse grid, metres: continents, shelves, climate.
+pub const COARSE_METRES: f64 = 8000.0;
+/// Ratio of the 4× block upsampling (block size / model pixel size).
+const BLOCK_RATIO: f64 = 1.0 / BLOCKS_PER_MODEL_PIXEL as f64;
 
 /// Channels of every pipeline answer.
 pub mod channel {
@@ -39,11 +50,15 @@ pub mod channel {
     pub const PRECIPITATION: usize = 3;
     /// Precipitation variability (coefficient of variation), %.
     pub const VARIABILITY: usize = 4;
+    /// Steepness of the land around, degrees: the slope of the smooth relief under the
+    /// erosion filter (what the learned grid resolves, ~1 km), the same at any world scale;
+    /// biome rules use it, so gullies do not speckle biomes.
+    pub const RELIEF_SLOPE: usize = 5;
     /// Number of channels.
-    pub const COUNT: usize = 5;
+    pub const COUNT: usize = 6;
     /// Channel names, in order, for files and legends.
     pub const NAMES: [&str; COUNT] =
-        ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct"];
+        ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct", "relief_slope_deg"];
 }
 
 /// Why a pipeline could not be built.
@@ -104,29 +119,14 @@ impl Source for BoxMean {
     }
 }
 
-/// A grid `factor`× finer than its source's, by exact bilinear interpolation.
-struct Upsampled {
-    source: Arc<dyn Source>,
-    factor: i64,
-}
-
-impl Source for Upsampled {
-    fn channels(&self) -> usize {
-        self.source.channels()
-    }
-
-    fn query(&self, rect: Rect) -> Tile {
-        upsample::bilinear(&self.source.query(upsample::source_rect(&rect, self.factor)), self.factor, rect)
-    }
-}
-
 /// The terrain pipeline for one seed: thread-safe, shared by every chunk worker.
 pub struct Pipeline {
     seed: u64,
     settings: TerrainSettings,
     engine: Arc<Engine>,
     stages: Vec<StageStatus>,
-    elevation: Arc<dyn Source>,
+    finest: Finest,
+    erosion: ErosionFilter,
     coarse_elevation: Arc<dyn Source>,
     coarse_sketch: Arc<dyn Source>,
     precipitation: Arc<Windowed>,
@@ -157,7 +157,7 @@ impl Pipeline {
             threads: settings.engine.threads as usize,
         });
         let layout = Layout::new(seed, &settings.layout);
-        let coarse_metres = MODEL_PIXEL_METRES * COARSE_FACTOR as f64;
+        let coarse_metres = COARSE_METRES;
         let mut stages = stages::current();
         let sketch = StageGrid::layout(Arc::new(layout.elevation(coarse_metres)), coarse_metres);
         // The learned stages, coarse to fine, each refining the output of its context stage
@@ -169,10 +169,8 @@ impl Pipeline {
             ran.push(grid);
         }
         // The coarse grid (climate, spawn search) carries the finest stage that lives on it.
-        let coarse_elevation = match ran.iter().rev().find(|g| g.metres == coarse_metres) {
-            Some(grid) => grid.clone().on_grid(coarse_metres)?,
-            None => sketch.source.clone(),
-        };
+        let coarse_elevation =
+            ran.iter().rev().find(|g| g.metres == coarse_metres).map_or(sketch.source.clone(), |g| g.source.clone());
         let coarse_sketch: Arc<dyn Source> = Arc::new(layout.climate_sketch(coarse_metres));
         let precipitation = Windowed::new(
             &engine,
@@ -186,17 +184,18 @@ impl Pipeline {
                 margin: 48,
             },
         );
-        // The model grid carries the finest stage that ran, bilinearly brought down to it.
-        let elevation: Arc<dyn Source> = match ran.pop() {
-            Some(finest) => finest.on_grid(MODEL_PIXEL_METRES)?,
-            None => Arc::new(layout.elevation(MODEL_PIXEL_METRES)),
-        };
+        // The model grid carries the finest stage that ran (the layout's 500 m grid when none
+        // did), resampled to it, with the erosion filter's octaves the grid can hold.
+        let base = ran.pop().unwrap_or_else(|| StageGrid::layout(Arc::new(layout.elevation(BASE_METRES)), BASE_METRES));
+        let erosion = ErosionFilter::new(seed);
+        let finest = Finest::new(base.source, base.metres, settings.model_pixel_metres(), erosion);
         Ok(Pipeline {
             seed,
             settings: settings.clone(),
             engine,
             stages,
-            elevation,
+            finest,
+            erosion,
             coarse_elevation,
             coarse_sketch,
             precipitation,
@@ -243,12 +242,29 @@ impl Pipeline {
         &self.engine
     }
 
+    /// Horizontal size of a block column, metres (`world.metres_per_block`).
+    pub fn block_metres(&self) -> f64 {
+        self.settings.metres_per_block
+    }
+
+    /// Size of a model pixel (4 blocks), metres.
+    pub fn model_pixel_metres(&self) -> f64 {
+        self.settings.model_pixel_metres()
+    }
+
     /// All channels (see [`channel`]) on the model grid, one value per model pixel.
     pub fn model(&self, rect: Rect) -> Tile {
-        let elevation = self.elevation.query(rect);
-        let coarse = upsample::source_rect(&rect, COARSE_FACTOR);
-        let sketch = upsample::bilinear(&self.coarse_sketch.query(coarse), COARSE_FACTOR, rect);
-        let rain = upsample::bilinear(&self.precipitation.query(coarse), COARSE_FACTOR, rect);
+        self.model_and_slope(rect).0
+    }
+
+    /// [`Pipeline::model`] and the smooth relief's slope (m/m) under the erosion filter.
+    fn model_and_slope(&self, rect: Rect) -> (Tile, Tile) {
+        let finest = self.finest.query(rect);
+        let ratio = self.model_pixel_metres() / COARSE_METRES;
+        let coarse = resample::source_rect(&rect, ratio, 0);
+        let sketch = resample::bilinear(&self.coarse_sketch.query(coarse), ratio, rect);
+        let rain = resample::bilinear(&self.precipitation.query(coarse), ratio, rect);
+        let elevation = finest.select(&[finest::ELEVATION]);
 
         let n = rect.area();
         let mut out = Tile::zeros(channel::COUNT, rect);
@@ -262,26 +278,87 @@ impl Pipeline {
         out.channel_mut(channel::SEASONALITY).copy_from_slice(sketch.channel(sketch::SEASONALITY));
         out.channel_mut(channel::PRECIPITATION).copy_from_slice(rain.channel(precipitation::ANNUAL_MM));
         out.channel_mut(channel::VARIABILITY).copy_from_slice(rain.channel(precipitation::VARIABILITY_PCT));
-        out
+        for (d, &s) in out.channel_mut(channel::RELIEF_SLOPE).iter_mut().zip(finest.channel(finest::SLOPE)) {
+            *d = s.atan().to_degrees();
+        }
+        (out, finest.select(&[finest::SLOPE]))
     }
 
     /// Elevation alone (metres, one channel) on the model grid: skips the climate model, so
     /// maps and exports of elevation stay cheap over huge areas.
     pub fn elevation(&self, rect: Rect) -> Tile {
-        self.elevation.query(rect)
+        self.finest.query(rect).select(&[finest::ELEVATION])
+    }
+
+    /// The model pixels the block columns of `blocks` are made from (with the margin their
+    /// gradients need).
+    fn model_rect(blocks: &Rect) -> Rect {
+        resample::source_rect(blocks, BLOCK_RATIO, 1).pad(1)
     }
 
     /// Elevation alone (metres, one channel) for every block column of `blocks`.
     pub fn elevation_columns(&self, blocks: Rect) -> Tile {
-        let model = self.elevation(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
-        upsample::bilinear(&model, BLOCKS_PER_MODEL_PIXEL, blocks)
+        let finest = self.finest.query(Pipeline::model_rect(&blocks));
+        let (elevation, _) = self.carve_blocks(&finest, blocks);
+        Tile::from_data(1, blocks, elevation)
     }
 
-    /// All channels for every block column of `blocks` (y = z, x = x in block coordinates),
-    /// bilinearly upsampled 4× from the model grid.
+    /// All channels for every block column of `blocks` (y = z, x = x in block coordinates):
+    /// the model grid upsampled 4× (elevation by a cubic, climate bilinearly), with the
+    /// erosion filter's octaves below the model grid carved into the elevation and the
+    /// temperature following it down the lapse rate.
     pub fn columns(&self, blocks: Rect) -> Tile {
-        let model = self.model(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
-        upsample::bilinear(&model, BLOCKS_PER_MODEL_PIXEL, blocks)
+        let (model, slope) = self.model_and_slope(Pipeline::model_rect(&blocks));
+        let finest = Tile::stack(&[&model.select(&[channel::ELEVATION]), &slope]);
+        let (elevation, smooth) = self.carve_blocks(&finest, blocks);
+        let mut out = resample::bilinear(&model, BLOCK_RATIO, blocks);
+        let lapse = self.settings.climate.lapse_rate_c_per_km as f32;
+        let n = blocks.area();
+        for (i, (&e, &b)) in elevation.iter().zip(&smooth).enumerate() {
+            out.data[channel::ELEVATION * n + i] = e;
+            // The climate model's lapse rate over the height the detail adds (nothing at sea).
+            out.data[channel::TEMPERATURE * n + i] -= lapse * (e.max(0.0) - b.max(0.0)) / 1000.0;
+        }
+        out
+    }
+
+    /// Block elevations of `blocks` from the model grid `finest` ([`finest`] channels, over
+    /// [`Pipeline::model_rect`]): the cubic upsampling plus the erosion octaves between 2 and
+    /// 8 blocks, steered by the model grid's gradient. Also returns the bilinear upsampling
+    /// (what the climate channels were interpolated with).
+    fn carve_blocks(&self, finest: &Tile, blocks: Rect) -> (Vec<f32>, Vec<f32>) {
+        let inner = resample::source_rect(&blocks, BLOCK_RATIO, 1);
+        let g = self.model_pixel_metres();
+        let mut fields = Tile::zeros(3, inner);
+        let m = inner.area();
+        let e = |y: i64, x: i64| f64::from(finest.get(finest::ELEVATION, y, x));
+        let mut i = 0;
+        for y in inner.y0..inner.y1() {
+            for x in inner.x0..inner.x1() {
+                fields.data[i] = ((e(y, x + 1) - e(y, x - 1)) / (2.0 * g)) as f32;
+                fields.data[m + i] = ((e(y + 1, x) - e(y - 1, x)) / (2.0 * g)) as f32;
+                fields.data[2 * m + i] = finest.get(finest::SLOPE, y, x);
+                i += 1;
+            }
+        }
+        let cubic = resample::cubic(&finest.select(&[finest::ELEVATION]), BLOCK_RATIO, blocks);
+        let smooth = resample::bilinear(&finest.select(&[finest::ELEVATION]), BLOCK_RATIO, blocks);
+        let fields = resample::bilinear(&fields, BLOCK_RATIO, blocks);
+        let b = self.block_metres();
+        let octaves = octaves_between(2.0 * b, 2.0 * g);
+        let n = blocks.area();
+        let mut out = cubic.data;
+        let mut i = 0;
+        for z in blocks.y0..blocks.y1() {
+            for x in blocks.x0..blocks.x1() {
+                let gradient = (f64::from(fields.data[i]), f64::from(fields.data[n + i]));
+                let slope = f64::from(fields.data[2 * n + i]);
+                let (xm, zm) = ((x as f64 + 0.5) * b, (z as f64 + 0.5) * b);
+                out[i] += self.erosion.apply(xm, zm, slope, gradient, octaves.clone()).height as f32;
+                i += 1;
+            }
+        }
+        (out, smooth.data)
     }
 
     /// Evaluates every window (learned stages and climate) that queries inside `blocks` need
@@ -290,55 +367,33 @@ impl Pipeline {
     /// procedural layout is computed per query anyway.
     pub fn prefetch(&self, blocks: Rect) {
         if !self.learned_stages().is_empty() {
-            self.model(upsample::source_rect(&blocks, BLOCKS_PER_MODEL_PIXEL));
+            self.model(Pipeline::model_rect(&blocks));
         }
     }
 
     /// Coarse elevation (metres) of the coarse cell holding a block column: cheap, for
     /// searching a spawn point or a region's character without running the full pipeline.
     pub fn coarse_elevation_at_block(&self, x: i64, z: i64) -> f32 {
-        let f = BLOCKS_PER_MODEL_PIXEL * COARSE_FACTOR;
-        let (cy, cx) = (crate::tile::div_floor(z, f), crate::tile::div_floor(x, f));
-        self.coarse_elevation.query(Rect::new(cy, cx, 1, 1)).data[0]
+        let cell = |b: i64| ((b as f64 + 0.5) * self.block_metres() / COARSE_METRES).floor() as i64;
+        self.coarse_elevation.query(Rect::new(cell(z), cell(x), 1, 1)).data[0]
     }
 }
 
-/// A stage's output on its own grid: a learned stage's, or the layout's sketch.
+/// A stage's output on its own grid: a learned stage's, or the layout's.
 #[derive(Clone)]
 struct StageGrid {
     /// The stage's window function behind the engine's cache.
     source: Arc<dyn Source>,
     /// Real size of one of its pixels, metres.
     metres: f64,
-    /// Its manifest (for errors).
-    file: String,
     /// Its name (`layout` for the sketch).
     name: &'static str,
 }
 
 impl StageGrid {
-    /// The layout's sketch on its grid of `metres`.
+    /// The layout's elevation on its grid of `metres`.
     fn layout(source: Arc<dyn Source>, metres: f64) -> StageGrid {
-        StageGrid { source, metres, file: String::new(), name: "layout" }
-    }
-
-    /// The stage brought to a grid of `target` metres by exact bilinear upsampling (its own
-    /// grid must be a whole multiple of the target's).
-    fn on_grid(self, target: f64) -> Result<Arc<dyn Source>, PipelineError> {
-        let factor = self.metres / target;
-        if factor < 1.0 || (factor - factor.round()).abs() > 1e-6 {
-            return Err(PipelineError::Resolution {
-                file: self.file,
-                stage: self.name.to_string(),
-                found: self.metres,
-                needed: format!("a whole multiple of {target} m per pixel"),
-            });
-        }
-        Ok(if factor.round() as i64 == 1 {
-            self.source
-        } else {
-            Arc::new(Upsampled { source: self.source, factor: factor.round() as i64 })
-        })
+        StageGrid { source, metres, name: "layout" }
     }
 }
 
@@ -394,7 +449,7 @@ fn learned_stage(
     for s in stages.iter_mut().filter(|s| s.name == name) {
         s.state = StageState::Active;
     }
-    Ok(StageGrid { source, metres, file, name })
+    Ok(StageGrid { source, metres, name })
 }
 
 #[cfg(not(feature = "learned"))]

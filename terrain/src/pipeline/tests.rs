@@ -70,6 +70,46 @@ fn a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
     assert_ne!(pipeline(78, 256, 1).columns(whole).data, reference.data, "the seed must matter");
 }
 
+fn at_scale(metres_per_block: f64) -> Pipeline {
+    Pipeline::new(21, &TerrainSettings { metres_per_block, ..Default::default() })
+}
+
+#[test]
+fn the_world_scale_changes_blocks_not_metres() {
+    // The same place in metres has the same continent and climate at any scale.
+    let (fine, coarse) = (at_scale(30.0), at_scale(120.0));
+    assert_eq!((fine.model_pixel_metres(), coarse.model_pixel_metres()), (120.0, 480.0));
+    for (x, z) in [(0i64, 0i64), (100_000, -40_000), (-2_000_000, 3_000_000)] {
+        // Block x at 120 m is block 4x at 30 m; both fall in the same 8 km cell.
+        assert_eq!(fine.coarse_elevation_at_block(4 * x + 1, 4 * z + 1), coarse.coarse_elevation_at_block(x, z));
+    }
+    // A 4,096-block square spans 4× the metres at 4× the scale: more relief in it.
+    let range = |p: &Pipeline| {
+        let t = p.elevation(Rect::new(-512, -512, 1024, 1024));
+        let (lo, hi) = t.data.iter().fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+        hi - lo
+    };
+    assert!(range(&coarse) > range(&fine), "{} vs {}", range(&coarse), range(&fine));
+}
+
+#[test]
+fn the_erosion_filter_carves_relief_below_the_model_grid() {
+    // Land, far enough inland to have slopes.
+    let p = at_scale(40.0);
+    let x = (0..4000i64).map(|i| i * 512).find(|&x| p.coarse_elevation_at_block(x, 0) > 800.0).expect("high land");
+    let blocks = Rect::new(-64, x - 64, 128, 128);
+    let carved = p.elevation_columns(blocks);
+    let model = p.elevation(Pipeline::model_rect(&blocks));
+    let smooth = resample::cubic(&model, BLOCK_RATIO, blocks);
+    let rms = (carved.data.iter().zip(&smooth.data).map(|(a, b)| f64::from(a - b).powi(2)).sum::<f64>()
+        / blocks.area() as f64)
+        .sqrt();
+    // The two block octaves add metres, not millimetres, and not hundreds of metres.
+    assert!(rms > 0.5 && rms < 100.0, "rms {rms} m");
+    // The block elevations are what the full answer carries.
+    assert!(p.columns(blocks).select(&[channel::ELEVATION]) == carved);
+}
+
 #[test]
 fn neighbouring_chunks_agree_with_one_big_query() {
     let p = pipeline(5, 64, 2);
@@ -91,7 +131,8 @@ fn far_away_costs_the_same_windows_and_never_overflows() {
     let origin = count(0, 0);
     // The bound from the window layout: a 512-block query touches at most this many
     // orographic windows on the coarse grid (plus one coarse cell of bilinear padding).
-    let coarse_len = 512 / (BLOCKS_PER_MODEL_PIXEL * COARSE_FACTOR) + 3;
+    let blocks_per_coarse_cell = COARSE_METRES / TerrainSettings::default().metres_per_block;
+    let coarse_len = (512.0 / blocks_per_coarse_cell).ceil() as i64 + 3;
     let layout = WindowLayout::square(32, 16, 0);
     let bound = layout.max_windows(coarse_len, coarse_len);
     assert!(origin > 0 && origin <= bound);
@@ -111,8 +152,9 @@ fn a_long_walk_keeps_the_cache_under_its_limit() {
     let mut s = 1u64;
     for _ in 0..300 {
         s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        x += ((s >> 33) % 2001) as i64 - 600; // a drift east, so new windows keep coming
-        z += ((s >> 45) % 1001) as i64 - 500;
+        // A drift east, so new windows keep coming (steps of a few km at the default scale).
+        x += 4 * (((s >> 33) % 2001) as i64 - 600);
+        z += 4 * (((s >> 45) % 1001) as i64 - 500);
         p.columns(Rect::new(z, x, 16, 16));
         assert!(p.engine_stats().cache_bytes <= 1 << 20);
     }

@@ -1,0 +1,151 @@
+//! Relief below the learned grids: an erosion filter that carves branching gullies and spurs
+//! along the downhill direction of the relief it is given, octave by octave, down to blocks.
+//!
+//! The learned stages stop at 1 km (500 m with the `detail` stage); real terrain keeps its
+//! structure down to tens of metres: valleys branch into gullies, ridges into spurs, and all
+//! of them run downhill. The filter sums octaves of *gully noise* ([`gullies`]): stripes
+//! whose crests and troughs run along the local downhill direction, blended over a jittered
+//! lattice. Each octave is steered by the slopes of the octaves before it, so small gullies
+//! run down the sides of large ones and the pattern branches. Amplitudes follow a self-affine
+//! law (Hurst exponent [`HURST`]) scaled by the smooth relief's slope: steep mountains get
+//! deep gullies, plains stay nearly flat. The constants were fitted on real terrain the
+//! models never train on (docs/learned-terrain.md, "Relief on foot").
+//!
+//! Written by hand: no crate does gradient-aligned erosion noise; the method follows the
+//! "erosion noise" of Clay John and Rune Skovbo Johansen's erosion filter (public shader
+//! code), adapted to metres, an explicit slope-scaled amplitude law and 64-bit hashing.
+//!
+//! A pure function of (seed, position in metres, the relief's gradient and slope there): no
+//! state and no neighbours, so any order of evaluation and any split into tiles or windows
+//! gives the same bits, and there is nothing to seam.
+
+#[cfg(test)]
+mod tests;
+
+use std::f64::consts::TAU;
+use std::ops::Range;
+
+/// Wavelength of the longest octave, metres: the band the 1 km learned grid only half
+/// resolves (its cubic resampling keeps little below ~3 km).
+pub const LONGEST_M: f64 = 4000.0;
+/// Amplitude of an octave relative to (slope × wavelength) at [`LONGEST_M`].
+pub const AMPLITUDE: f64 = 0.3;
+/// Hurst exponent of the octave amplitudes: each halving of the wavelength keeps 2^−H of the
+/// amplitude (real terrain: ≈ 0.8–0.9 from 100 m to 10 km).
+pub const HURST: f64 = 0.9;
+/// Slope (m/m) below which a plain is treated as this steep, so flat land keeps a few metres
+/// of relief instead of none.
+pub const FLOOR_SLOPE: f64 = 0.005;
+/// How strongly an octave's slopes turn the next octave's downhill direction.
+const STEER: f64 = 1.0;
+/// Octaves that exist at all (wavelength 4 km down to ≈ 1 m).
+pub const MAX_OCTAVES: u32 = 12;
+
+/// Wavelength of octave `k` (0 is the longest), metres.
+pub fn wavelength(k: u32) -> f64 {
+    LONGEST_M / f64::from(1u32 << k)
+}
+
+/// The octaves whose wavelength is at least `shortest_m` and below `longest_m` (metres).
+pub fn octaves_between(shortest_m: f64, longest_m: f64) -> Range<u32> {
+    let first = (0..MAX_OCTAVES).find(|&k| wavelength(k) < longest_m).unwrap_or(MAX_OCTAVES);
+    let end = (0..MAX_OCTAVES).find(|&k| wavelength(k) < shortest_m).unwrap_or(MAX_OCTAVES);
+    first..end.max(first)
+}
+
+/// Amplitude (metres) of an octave of wavelength `lambda` over relief of slope `slope`.
+fn amplitude(lambda: f64, slope: f64) -> f64 {
+    let relative = lambda / LONGEST_M;
+    // The longest octaves overlap what the learned grid already holds: taper them.
+    let taper = 1.0 - 0.5 * relative;
+    AMPLITUDE * slope.max(FLOOR_SLOPE) * lambda * relative.powf(HURST - 1.0) * taper
+}
+
+/// The erosion filter of one world seed.
+#[derive(Clone, Copy, Debug)]
+pub struct ErosionFilter {
+    seed: u64,
+}
+
+/// What [`ErosionFilter::apply`] adds at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Carved {
+    /// Height added, metres.
+    pub height: f64,
+    /// The gradient (∂h/∂x, ∂h/∂z) carried on: the input gradient plus the octaves' slopes
+    /// (steers finer octaves run after these).
+    pub gradient: (f64, f64),
+}
+
+impl ErosionFilter {
+    /// The filter of world seed `seed`.
+    pub fn new(seed: u64) -> ErosionFilter {
+        ErosionFilter { seed: splitmix(seed ^ 0xE205_1011_F11E_0001) }
+    }
+
+    /// Octaves `octaves` at the point (`x`, `z`) metres, over relief whose gradient there is
+    /// `gradient` (m/m, x east, z south) and whose slope (the smooth relief's, which sets the
+    /// amplitudes) is `slope`.
+    pub fn apply(&self, x: f64, z: f64, slope: f64, gradient: (f64, f64), octaves: Range<u32>) -> Carved {
+        let (mut gx, mut gz) = gradient;
+        let mut height = 0.0;
+        for k in octaves {
+            let lambda = wavelength(k);
+            let norm = gx.hypot(gz);
+            // Downhill; on dead-flat ground any fixed direction will do.
+            let dir = if norm > 1e-12 { (-gx / norm, -gz / norm) } else { (1.0, 0.0) };
+            let g = gullies(splitmix(self.seed ^ u64::from(k)), x / lambda, z / lambda, dir);
+            let amp = amplitude(lambda, slope);
+            height += amp * g.value;
+            gx += STEER * amp * g.dx / lambda;
+            gz += STEER * amp * g.dz / lambda;
+        }
+        Carved { height, gradient: (gx, gz) }
+    }
+}
+
+/// One octave of gully noise and its derivatives (per unit of the octave's coordinates).
+#[derive(Clone, Copy, Debug)]
+struct Gully {
+    value: f64,
+    dx: f64,
+    dz: f64,
+}
+
+/// Gully noise at (`px`, `pz`) in lattice units: a cosine stripe through every jittered
+/// lattice point whose crests run along `dir` (unit, downhill), blended with Gaussian
+/// weights over the 4×4 nearest points. In [−1, 1].
+fn gullies(seed: u64, px: f64, pz: f64, dir: (f64, f64)) -> Gully {
+    let (ix, iz) = (px.floor(), pz.floor());
+    let (fx, fz) = (px - ix, pz - iz);
+    let (cx, cz) = (ix as i64, iz as i64);
+    // Across the flow: the stripe's phase changes only in this direction.
+    let across = (-dir.1, dir.0);
+    let (mut value, mut dx, mut dz, mut total) = (0.0, 0.0, 0.0, 0.0);
+    for j in -1..=2i64 {
+        for i in -1..=2i64 {
+            let h = splitmix(
+                seed ^ (cx.wrapping_add(i) as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                    ^ (cz.wrapping_add(j) as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F),
+            );
+            let jx = (h >> 40) as f64 / (1u64 << 24) as f64;
+            let jz = ((h >> 16) & 0xFF_FFFF) as f64 / (1u64 << 24) as f64;
+            let (ox, oz) = (fx - (i as f64 + 0.5 * jx), fz - (j as f64 + 0.5 * jz));
+            let w = (-2.0 * (ox * ox + oz * oz)).exp();
+            let (s, c) = (TAU * (ox * across.0 + oz * across.1)).sin_cos();
+            value += c * w;
+            dx -= s * TAU * across.0 * w;
+            dz -= s * TAU * across.1 * w;
+            total += w;
+        }
+    }
+    Gully { value: value / total, dx: dx / total, dz: dz / total }
+}
+
+/// SplitMix64's finaliser: a well-mixed 64-bit hash of `x`.
+fn splitmix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}

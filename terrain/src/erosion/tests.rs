@@ -1,0 +1,66 @@
+use super::*;
+
+fn field(filter: &ErosionFilter, slope: f64, gradient: (f64, f64), octaves: Range<u32>) -> Vec<f64> {
+    (0..64)
+        .flat_map(|i| (0..64).map(move |j| (i as f64 * 37.0, j as f64 * 37.0)))
+        .map(|(z, x)| filter.apply(x, z, slope, gradient, octaves.clone()).height)
+        .collect()
+}
+
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|h| h * h).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+#[test]
+fn the_same_point_gives_the_same_bits_and_seeds_differ() {
+    let (a, b) = (ErosionFilter::new(7), ErosionFilter::new(8));
+    let at = |f: &ErosionFilter| f.apply(12_345.5, -987_654.25, 0.2, (0.1, -0.15), 0..8);
+    assert_eq!(at(&a).height.to_bits(), at(&ErosionFilter::new(7)).height.to_bits());
+    assert_ne!(at(&a).height, at(&b).height);
+    // Far from the origin the lattice still hashes and the values stay bounded.
+    let far = a.apply(7.5e9, -7.5e9, 0.3, (0.2, 0.2), 0..8);
+    assert!(far.height.is_finite() && far.height.abs() < 2_000.0, "{far:?}");
+}
+
+#[test]
+fn octave_bands_split_the_ladder_without_gap_or_overlap() {
+    // The model grid takes wavelengths ≥ 2 grid pixels, blocks the rest down to 2 blocks.
+    for block in [15.0, 40.0, 125.0, 250.0] {
+        let grid = octaves_between(8.0 * block, f64::INFINITY);
+        let blocks = octaves_between(2.0 * block, 8.0 * block);
+        assert_eq!(grid.start, 0);
+        assert_eq!(grid.end, blocks.start, "{block} m/block");
+        assert!(wavelength(blocks.end - 1) >= 2.0 * block);
+        assert!(blocks.end == MAX_OCTAVES || wavelength(blocks.end) < 2.0 * block);
+        assert_eq!(blocks.len(), 2, "two octaves below the 4-block grid at {block} m/block");
+    }
+}
+
+#[test]
+fn steep_relief_is_carved_deeper_than_plains() {
+    let f = ErosionFilter::new(1);
+    let plain = rms(&field(&f, 0.001, (0.001, 0.0), 0..6));
+    let hills = rms(&field(&f, 0.1, (0.1, 0.0), 0..6));
+    let mountains = rms(&field(&f, 0.5, (0.5, 0.0), 0..6));
+    assert!(plain < 15.0, "plains keep a few metres: {plain}");
+    assert!(hills > 4.0 * plain && mountains > 4.0 * hills, "{plain} {hills} {mountains}");
+}
+
+#[test]
+fn gullies_run_downhill() {
+    // One octave on a slope falling to +x: the height changes far less along the flow than
+    // across it (the stripes' crests and troughs run downhill).
+    let f = ErosionFilter::new(3);
+    let k = 3;
+    let lag = wavelength(k) / 8.0;
+    let h = |x: f64, z: f64| f.apply(x, z, 0.2, (-0.2, 0.0), k..k + 1).height;
+    let (mut along, mut across) = (0.0, 0.0);
+    for i in 0..40 {
+        for j in 0..40 {
+            let (x, z) = (i as f64 * 61.0, j as f64 * 59.0);
+            along += (h(x + lag, z) - h(x, z)).powi(2);
+            across += (h(x, z + lag) - h(x, z)).powi(2);
+        }
+    }
+    assert!(across > 4.0 * along, "across {across} along {along}");
+}

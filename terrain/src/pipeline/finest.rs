@@ -1,0 +1,66 @@
+//! The model grid (4 blocks a pixel, at any world scale): the finest stage that ran,
+//! resampled to it by a cubic, with the erosion filter's octaves that the grid can hold
+//! (wavelengths of two pixels and more).
+
+use std::sync::Arc;
+
+use crate::erosion::{octaves_between, ErosionFilter};
+use crate::infinite::Source;
+use crate::resample;
+use crate::tile::{Rect, Tile};
+
+/// Channel: elevation, metres.
+pub const ELEVATION: usize = 0;
+/// Channel: slope of the smooth relief under the erosion filter (m/m), which sets the
+/// amplitude of the octaves carved at the block grid too.
+pub const SLOPE: usize = 1;
+
+/// The model grid's elevation source.
+pub struct Finest {
+    base: Arc<dyn Source>,
+    ratio: f64,
+    metres: f64,
+    erosion: ErosionFilter,
+    octaves: std::ops::Range<u32>,
+}
+
+impl Finest {
+    /// The model grid of `metres` pixels over `base` (a grid of `base_metres` pixels).
+    pub fn new(base: Arc<dyn Source>, base_metres: f64, metres: f64, erosion: ErosionFilter) -> Finest {
+        Finest {
+            base,
+            ratio: metres / base_metres,
+            metres,
+            erosion,
+            octaves: octaves_between(2.0 * metres, f64::INFINITY),
+        }
+    }
+}
+
+impl Source for Finest {
+    fn channels(&self) -> usize {
+        2
+    }
+
+    fn query(&self, rect: Rect) -> Tile {
+        let padded = rect.pad(1);
+        let base = resample::cubic(&self.base.query(resample::source_rect(&padded, self.ratio, 1)), self.ratio, padded);
+        let e = |y: i64, x: i64| f64::from(base.get(0, y, x));
+        let g = self.metres;
+        let mut out = Tile::zeros(2, rect);
+        let n = rect.area();
+        let mut i = 0;
+        for y in rect.y0..rect.y1() {
+            for x in rect.x0..rect.x1() {
+                let gradient = ((e(y, x + 1) - e(y, x - 1)) / (2.0 * g), (e(y + 1, x) - e(y - 1, x)) / (2.0 * g));
+                let slope = gradient.0.hypot(gradient.1);
+                let (xm, zm) = ((x as f64 + 0.5) * g, (y as f64 + 0.5) * g);
+                let carved = self.erosion.apply(xm, zm, slope, gradient, self.octaves.clone());
+                out.data[i] = (e(y, x) + carved.height) as f32;
+                out.data[n + i] = slope as f32;
+                i += 1;
+            }
+        }
+        out
+    }
+}
