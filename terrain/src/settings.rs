@@ -187,6 +187,9 @@ impl EngineSettings {
     }
 }
 
+/// Blocks per model pixel (horizontally), whatever the world's scale: the model grid is
+/// always 4 blocks (the pipeline re-exports it).
+pub const BLOCKS_PER_MODEL_PIXEL: i64 = 4;
 /// Horizontal size of a block column by default, metres (`world.metres_per_block`).
 pub const DEFAULT_METRES_PER_BLOCK: f64 = 125.0;
 /// The horizontal scales a world may have, metres per block.
@@ -219,9 +222,9 @@ impl Default for TerrainSettings {
 }
 
 impl TerrainSettings {
-    /// Size of a model pixel (always 4 blocks), metres.
+    /// Size of a model pixel (always [`BLOCKS_PER_MODEL_PIXEL`] blocks), metres.
     pub fn model_pixel_metres(&self) -> f64 {
-        self.metres_per_block * crate::pipeline::BLOCKS_PER_MODEL_PIXEL as f64
+        self.metres_per_block * BLOCKS_PER_MODEL_PIXEL as f64
     }
 
     /// Checks every value against its range.

@@ -23,13 +23,11 @@ use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, W
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
 use crate::resample;
+pub use crate::settings::BLOCKS_PER_MODEL_PIXEL;
 use crate::settings::{StageName, TerrainSettings};
 use crate::tile::{Rect, Tile};
 use finest::Finest;
 
-/// Minecraft blocks per model pixel (horizontally), whatever the world's scale: the model
-/// grid is always 4 blocks.
-pub const BLOCKS_PER_MODEL_PIXEL: i64 = 4;
 /// The finest grid a stage is trained on, metres: the layout's and the `detail` stage's
 /// (the learned windows' seams are measured on it).
 pub const BASE_METRES: f64 = 500.0;
