@@ -38,6 +38,14 @@ fn taps(d0: i64, n: i64, ratio: f64, origin: i64) -> Vec<(usize, f64)> {
         .collect()
 }
 
+/// The row and column taps of `target` on `source`, which must cover
+/// [`source_rect`]`(target, ratio, reach)`.
+fn plan(source: &Tile, ratio: f64, target: Rect, reach: i64) -> (Vec<(usize, f64)>, Vec<(usize, f64)>) {
+    let need = source_rect(&target, ratio, reach);
+    assert!(source.rect.contains_rect(&need), "resampling {target:?} needs {need:?}, got {:?}", source.rect);
+    (taps(target.y0, target.h, ratio, source.rect.y0), taps(target.x0, target.w, ratio, source.rect.x0))
+}
+
 /// Catmull-Rom weights of the taps at −1, 0, 1, 2 for fraction `t`.
 fn catmull_rom(t: f64) -> [f64; 4] {
     let (t2, t3) = (t * t, t * t * t);
@@ -47,10 +55,7 @@ fn catmull_rom(t: f64) -> [f64; 4] {
 /// Every channel of `source` bilinearly resampled onto `target` (`ratio` = target pixel /
 /// source pixel); `source` must cover [`source_rect`]`(target, ratio, 0)`.
 pub fn bilinear(source: &Tile, ratio: f64, target: Rect) -> Tile {
-    let need = source_rect(&target, ratio, 0);
-    assert!(source.rect.contains_rect(&need), "resampling {target:?} needs {need:?}, got {:?}", source.rect);
-    let ty = taps(target.y0, target.h, ratio, source.rect.y0);
-    let tx = taps(target.x0, target.w, ratio, source.rect.x0);
+    let (ty, tx) = plan(source, ratio, target, 0);
     let sw = source.width();
     let mut out = Tile::zeros(source.channels, target);
     let mut k = 0;
@@ -73,10 +78,7 @@ pub fn bilinear(source: &Tile, ratio: f64, target: Rect) -> Tile {
 /// slopes across source cell borders, where bilinear leaves creases); `source` must cover
 /// [`source_rect`]`(target, ratio, 1)`.
 pub fn cubic(source: &Tile, ratio: f64, target: Rect) -> Tile {
-    let need = source_rect(&target, ratio, 1);
-    assert!(source.rect.contains_rect(&need), "resampling {target:?} needs {need:?}, got {:?}", source.rect);
-    let ty = taps(target.y0, target.h, ratio, source.rect.y0);
-    let tx = taps(target.x0, target.w, ratio, source.rect.x0);
+    let (ty, tx) = plan(source, ratio, target, 1);
     let wx: Vec<[f64; 4]> = tx.iter().map(|&(_, t)| catmull_rom(t)).collect();
     let sw = source.width();
     let mut out = Tile::zeros(source.channels, target);
