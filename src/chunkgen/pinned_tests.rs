@@ -112,18 +112,19 @@ fn hash_biomes(chunk: &UnloadedChunk, h: &mut Fnv) {
 }
 
 /// Regions of the default configuration's world (seed 1, procedural pipeline), as the chunk
-/// of their north-west corner: deep sea, a coast with shallows, and mountains.
-const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -30), (12, 0), (-48, 72)];
+/// of their north-west corner: deep sea, a coast with shallows, and mountains (at the
+/// default 40 m/block; the places of the 125 m world, in the same metres).
+const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
 /// world with the shipped biome rules) outside the shallow sea, recorded before the sea fix.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0x56ae_f100_a333_d0f8;
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xd0fc_43aa_eb4b_b4fc;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], recorded after the sea fix.
-const PROCEDURAL_HASH: u64 = 0xf3a1_2b85_6ec3_2041;
-/// [`hash_region`] of the 2×2 chunks at chunk (12, 0) with the shipped learned core (no
-/// shallow sea there), recorded before the sea fix.
+const PROCEDURAL_HASH: u64 = 0x074a_5ead_fbf0_5c38;
+/// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
+/// with the shipped learned core.
 #[cfg(feature = "learned")]
-const LEARNED_HASH: u64 = 0x5f00_7e90_ebba_bfdc;
+const LEARNED_HASH: u64 = 0x66fc_ed13_1891_e436;
 
 fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();
@@ -158,6 +159,6 @@ fn the_world_of_the_shipped_core_is_the_recorded_one() {
     let g = Generator::new(Arc::new(pipeline), &config);
     let (rules, palette) = (shipped_rules(), BiomePalette::vanilla());
     let mut h = Fnv::new();
-    hash_region(&g, &rules, &palette, (12, 0), 2, None, &mut h);
+    hash_region(&g, &rules, &palette, PROCEDURAL_REGIONS[2], 2, None, &mut h);
     assert_eq!(h.0, LEARNED_HASH, "the world changed: {:#018x}", h.0);
 }

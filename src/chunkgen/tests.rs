@@ -185,9 +185,26 @@ fn check_sea(g: &Generator, rules: &BiomeRules, (cx0, cz0): (i32, i32), n: i32) 
 
 #[test]
 fn the_sea_is_water_up_to_the_water_top_and_frozen_where_cold() {
-    // A deep-sea chunk of seed 1 that the 0 °C line of the sea surface crosses (found by
-    // bisection along x = 8): some of its columns freeze, the others stay open.
-    let (land, open, frozen) = check_sea(&generator(1), &rules(), (0, -1192), 1);
+    // A deep-sea chunk of seed 1 that the 0 °C line of the sea surface crosses: some of its
+    // columns freeze, the others stay open. Searched for near the place where it lay at
+    // 125 m/block (the layout and climate live in metres, so it moves with the scale).
+    let g = generator(1);
+    let v = *g.vertical();
+    let guess = at_scale(&g, (0, -1192));
+    let chunk = find_chunks(guess, 200, 1, |rect| {
+        let columns = Columns::query(g.pipeline(), &v, rect);
+        let (mut open, mut frozen) = (0, 0);
+        for (x, z) in rect_columns(rect) {
+            if columns.elevation(x, z) > -200.0 {
+                return false;
+            }
+            let cold = columns.get(channel::TEMPERATURE, x, z) < surface::SEA_ICE_C;
+            (frozen, open) = (frozen + usize::from(cold), open + usize::from(!cold));
+        }
+        open > 0 && frozen > 0
+    })
+    .expect("no deep-sea chunk on the 0 °C line near the old one");
+    let (land, open, frozen) = check_sea(&g, &rules(), chunk, 1);
     assert_eq!(land, 0);
     assert!(open > 0 && frozen > 0, "{open} open and {frozen} frozen sea columns: pick a chunk on the 0 °C line");
 }
@@ -195,15 +212,23 @@ fn the_sea_is_water_up_to_the_water_top_and_frozen_where_cold() {
 #[test]
 fn every_sea_column_is_under_water_even_the_shallowest() {
     // 3×3 chunks of seed 1's coast: shallows, beach and land (before the sea fix, ground at
-    // −60 m .. 0 m lay dry at the water top).
+    // −60 m .. 0 m lay dry at the water top), searched for near where they lay at 125 m/block.
     let g = generator(1);
     let v = *g.vertical();
-    let columns = Columns::query(g.pipeline(), &v, Rect::new(2 * 16, 13 * 16, 48, 48));
-    let shallow = (2 * 16..5 * 16)
-        .flat_map(|z| (13 * 16..16 * 16).map(move |x| (x, z)))
-        .filter(|&(x, z)| columns.elevation(x, z) > -60.0 && columns.elevation(x, z) < 0.0)
-        .count();
-    let (land, open, _) = check_sea(&g, &rules(), (13, 2), 3);
+    // (land, sea, shallow sea) columns of a rectangle, by the pipeline's elevation.
+    let kinds = |rect: Rect| {
+        let columns = Columns::query(g.pipeline(), &v, rect);
+        let e: Vec<f32> = rect_columns(rect).map(|(x, z)| columns.elevation(x, z)).collect();
+        let count = |f: fn(f32) -> bool| e.iter().filter(|&&e| f(e)).count();
+        (count(|e| e >= 0.0), count(|e| e < 0.0), count(|e| e > -60.0 && e < 0.0))
+    };
+    let corner = find_chunks(at_scale(&g, (13, 2)), 60, 3, |rect| {
+        let (land, sea, shallow) = kinds(rect);
+        land > 300 && sea > 300 && shallow > 200
+    })
+    .expect("no coast with shallows near the old one");
+    let shallow = kinds(chunk_rect(corner, 3)).2;
+    let (land, open, _) = check_sea(&g, &rules(), corner, 3);
     assert!(land > 100 && open > 100 && shallow > 100, "{land} land, {open} sea, {shallow} shallow columns");
 }
 
@@ -213,13 +238,7 @@ fn woodland_grows_trees_that_stand_on_the_ground() {
     let rules = BiomeRules::from_sources(&[(PathBuf::from("forest.toml"), forest.to_string())]).expect("forest rules");
     let (g, palette) = (generator(4), palette());
     let v = *g.vertical();
-    // Land chunks near the origin (this seed's origin may be sea).
-    let land: Vec<(i32, i32)> = (-30..30)
-        .flat_map(|cz| (-30..30).map(move |cx| (cx, cz)))
-        .filter(|&(cx, cz)| g.surface(&rules, i64::from(cx) * 16 + 8, i64::from(cz) * 16 + 8).y > v.sea_level_y + 2)
-        .take(8)
-        .collect();
-    assert_eq!(land.len(), 8, "no land near the origin for seed 4");
+    let land = land_chunks(&g, &rules, 8);
     let mut trunks = 0;
     for &(cx, cz) in &land {
         let chunk = g.chunk(&rules, &palette, cx, cz);
@@ -242,16 +261,49 @@ fn single_biome(biome: &str) -> BiomeRules {
     testing::single_biome(&format!("minecraft:{biome}"))
 }
 
-/// `n` land chunks near the origin, well above the sea.
+/// `n` land chunks near the world's spawn (the origin may be open sea), well above the sea.
 fn land_chunks(g: &Generator, rules: &BiomeRules, n: usize) -> Vec<(i32, i32)> {
     let v = *g.vertical();
-    let land: Vec<(i32, i32)> = (-30..30)
-        .flat_map(|cz| (-30..30).map(move |cx| (cx, cz)))
+    let spawn = crate::world::find_spawn(g, rules).block;
+    let centre = (spawn.x.div_euclid(16), spawn.z.div_euclid(16));
+    let land: Vec<(i32, i32)> = (0..30)
+        .flat_map(|ring| ring_chunks(centre, ring))
         .filter(|&(cx, cz)| g.surface(rules, i64::from(cx) * 16 + 8, i64::from(cz) * 16 + 8).y > v.sea_level_y + 2)
         .take(n)
         .collect();
-    assert_eq!(land.len(), n, "not enough land near the origin");
+    assert_eq!(land.len(), n, "not enough land near the spawn {spawn:?}");
     land
+}
+
+/// The chunks on the square ring `ring` chunks from `centre`.
+fn ring_chunks((cx, cz): (i32, i32), ring: i32) -> impl Iterator<Item = (i32, i32)> {
+    (-ring..=ring)
+        .flat_map(move |dz| (-ring..=ring).map(move |dx| (dx, dz)))
+        .filter(move |&(dx, dz)| dx.abs().max(dz.abs()) == ring)
+        .map(move |(dx, dz)| (cx + dx, cz + dz))
+}
+
+/// The block rectangle of the `n`×`n` chunks from chunk `corner`.
+fn chunk_rect((cx, cz): (i32, i32), n: i32) -> Rect {
+    Rect::new(i64::from(cz) * 16, i64::from(cx) * 16, 16 * i64::from(n), 16 * i64::from(n))
+}
+
+/// Every (x, z) column of `rect`.
+fn rect_columns(rect: Rect) -> impl Iterator<Item = (i64, i64)> {
+    (rect.y0..rect.y0 + rect.h).flat_map(move |z| (rect.x0..rect.x0 + rect.w).map(move |x| (x, z)))
+}
+
+/// The chunk that lay at `chunk` at the old fixed 125 m/block, at `g`'s scale (same metres).
+fn at_scale(g: &Generator, (cx, cz): (i32, i32)) -> (i32, i32) {
+    let k = 125.0 / g.pipeline().block_metres();
+    ((f64::from(cx) * k).round() as i32, (f64::from(cz) * k).round() as i32)
+}
+
+/// The corner of the nearest `n`×`n` chunks to `centre` (within `radius` rings) whose block
+/// rectangle satisfies `want`: lets a test find the sea, coast or climate it needs wherever the
+/// scale puts it, instead of hard-coding a place.
+fn find_chunks(centre: (i32, i32), radius: i32, n: i32, want: impl Fn(Rect) -> bool) -> Option<(i32, i32)> {
+    (0..=radius).flat_map(|ring| ring_chunks(centre, ring)).find(|&c| want(chunk_rect(c, n)))
 }
 
 /// The plant blocks standing on the ground of a chunk column, bottom up.

@@ -191,7 +191,7 @@ impl EngineSettings {
 /// always 4 blocks (the pipeline re-exports it).
 pub const BLOCKS_PER_MODEL_PIXEL: i64 = 4;
 /// Horizontal size of a block column by default, metres (`world.metres_per_block`).
-pub const DEFAULT_METRES_PER_BLOCK: f64 = 125.0;
+pub const DEFAULT_METRES_PER_BLOCK: f64 = 40.0;
 /// The horizontal scales a world may have, metres per block.
 pub const METRES_PER_BLOCK_RANGE: (f64, f64) = (15.0, 250.0);
 
