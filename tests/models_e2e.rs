@@ -11,8 +11,12 @@ use infiniterra::terrain::pipeline::channel;
 use infiniterra::terrain::tile::Rect;
 
 /// The shipped configuration's pipeline with `learned` stages on `threads` engine threads.
+/// At 125 m/block, where the model grid (4 blocks) is the detail stage's own 500 m grid, so
+/// 1 km cells are exact 2×2 boxes of it.
 fn pipeline(learned: &[&str], threads: u64) -> Pipeline {
-    fixtures::learned_pipeline(&fixtures::shipped_config(), learned, threads)
+    let mut config = fixtures::shipped_config();
+    config.world.metres_per_block = 125.0;
+    fixtures::learned_pipeline(&config, learned, threads)
 }
 
 #[test]
