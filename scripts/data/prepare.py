@@ -39,7 +39,12 @@ GLOBE stores sea and below-sea-level land both as 0. The global land mask decide
 is which: sea pixels of core tiles take ETOPO5 bathymetry (at most −1 m), land keeps GLOBE
 (sub-sea land such as the Caspian depression stays at 0 m: GLOBE has no value for it).
 
-    python3 scripts/data/prepare.py [--data-dir data]
+Besides the learned stages' sets, it makes the block-scale reference sets of `fine.py`
+(`fine-93m`, `fine-125m`, `fine-kossou-93m`, `fine-kossou-125m`: real 3" terrain for `eval`
+only, not stages of the hierarchy, so they are kept out of STAGES, which must equal the
+pipeline's stage table).
+
+    python3 scripts/data/prepare.py [--data-dir data] [--stage NAME ...]
 """
 
 import argparse
@@ -131,9 +136,12 @@ def make_tiles(stage, grids, mask, log):
 
 
 def write_stage(stage, kept, skipped, candidates, out_dir, inputs):
-    """Writes the stacks, sidecars and manifest of one stage; returns the split summaries."""
+    """Writes the stacks, sidecars and manifest of one stage; returns the split summaries.
+    A stage may set its own `tile` side and `projection`/`land_mask` descriptions, and add
+    keys to the manifest with `manifest_extra` (the reference sets of fine.py do)."""
     import numpy as np
 
+    tile = stage.get("tile", TILE)
     os.makedirs(out_dir, exist_ok=True)
     splits, tiles = {}, []
     for split in ("train", "heldout"):
@@ -151,19 +159,21 @@ def write_stage(stage, kept, skipped, candidates, out_dir, inputs):
                    "min": round(float(elev.min()), 1), "max": round(float(elev.max()), 1),
                    "median_tile_std": round(float(np.median([t[0]["std"] for t in chosen])), 1)}
         splits[split] = summary
-        sidecar = {"stage": stage["name"], "split": split, "metres_per_pixel": stage["metres"], "tile": TILE,
+        sidecar = {"stage": stage["name"], "split": split, "metres_per_pixel": stage["metres"], "tile": tile,
                    "count": len(chosen), "source": stage["describe"]}
         write_json(os.path.join(out_dir, f"{split}.json"), sidecar)
     manifest = {
         "stage": stage["name"], "source": stage["describe"], "inputs": inputs,
-        "metres_per_pixel": stage["metres"], "tile": TILE,
-        "layout": f"float32 metres, tiles stacked along rows: shape (N*{TILE}, {TILE}), row 0 north, col 0 west",
+        "metres_per_pixel": stage["metres"], "tile": tile,
+        "layout": f"float32 metres, tiles stacked along rows: shape (N*{tile}, {tile}), row 0 north, col 0 west",
         "encoding": "metres; signed sqrt and Laplacian split are applied at load (infiniterra_terrain::encoding)",
-        "projection": "per-tile local sinusoidal (square, equal-area pixels), bilinear after Gaussian anti-alias",
-        "land_mask": "global-land-mask==1.0.0 (30\"), bilinear, land where >= 0.5",
+        "projection": stage.get("projection", "per-tile local sinusoidal (square, equal-area pixels), "
+                                              "bilinear after Gaussian anti-alias"),
+        "land_mask": stage.get("land_mask", "global-land-mask==1.0.0 (30\"), bilinear, land where >= 0.5"),
         "filter": {"min_land_fraction": stage["min_land"], "min_std_m": stage["min_std"],
                    "overlap": stage["overlap"]},
         "heldout_region": heldout_region(stage),
+        **stage.get("manifest_extra", {}),
         "candidates": candidates, "skipped": skipped, "splits": splits, "tiles": tiles,
     }
     write_json(os.path.join(out_dir, "manifest.json"), manifest)
@@ -172,6 +182,8 @@ def write_stage(stage, kept, skipped, candidates, out_dir, inputs):
 
 def heldout_region(stage):
     """The manifest's one-line description of a stage's held-out region."""
+    if "heldout_rule" in stage:
+        return stage["heldout_rule"]
     if "heldout_blocks" in stage:
         n = stage["heldout_blocks"]
         return f"squares of {n}x{n} tiles whose block row and block column (row // {n}, col // {n}) are both odd"
@@ -200,14 +212,17 @@ def write_json(path, value):
 STAGE_INPUTS = {"coarse": ["etopo5", "mask"], "core": ["globe", "etopo5", "mask"], "detail": ["gebco", "mask"]}
 
 
-def input_hashes(extracted):
-    """{source key: [its pinned download, its extracted file]} with sha256 each."""
+def input_hashes(extracted, keys=None):
+    """{source key: [its pinned download, its extracted file]} with sha256 each, for `keys`
+    (default: every source)."""
     import sources
     from fetch import SOURCES
 
     pinned = read_checksums()
     out = {}
     for key, _registry, _requirement, artifact, _members in SOURCES:
+        if keys is not None and key not in keys:
+            continue
         out[key] = [{"file": f"raw/downloads/{artifact}", "sha256": pinned.get(artifact)},
                     {"file": f"raw/extracted/{sources.FILES[key]}", "sha256": sha256_of(sources.path(extracted, key))}]
     return out
@@ -220,7 +235,8 @@ def prepare(data_dir, stages):
 
     extracted = os.path.join(data_dir, "raw", "extracted")
     out_root = os.path.join(data_dir, "prepared")
-    inputs = input_hashes(extracted)
+    chosen = [s["name"] for s in STAGES if not stages or s["name"] in stages]
+    inputs = input_hashes(extracted, {key for name in chosen for key in STAGE_INPUTS[name]})
     print("reading sources", flush=True)
     grids = {"etopo5": sources.etopo5(extracted), "globe": sources.globe(extracted), "gebco": sources.gebco(extracted)}
     mask = sources.LandMask(extracted)
@@ -247,10 +263,10 @@ def prepare(data_dir, stages):
 
 
 def print_summary(summary):
-    print(f"\n{'set':<8}{'split':<9}{'tiles':>6}{'land':>7}{'min m':>9}{'max m':>8}{'med std':>9}")
+    print(f"\n{'set':<10}{'split':<9}{'tiles':>6}{'land':>7}{'min m':>9}{'max m':>8}{'med std':>9}")
     for name, splits in summary.items():
         for split, s in splits.items():
-            print(f"{name:<8}{split:<9}{s['count']:>6}{s['land_fraction']:>7.2f}{s['min']:>9.0f}{s['max']:>8.0f}"
+            print(f"{name:<10}{split:<9}{s['count']:>6}{s['land_fraction']:>7.2f}{s['min']:>9.0f}{s['max']:>8.0f}"
                   f"{s['median_tile_std']:>9.0f}")
 
 
@@ -273,20 +289,34 @@ def self_test():
     assert split_of(-100.0, -90.0, (-110.0, -50.0)) == "heldout"
     assert split_of(100.0, 110.0, (-110.0, -50.0)) == "train" and split_of(250.0, 260.0, (-110.0, -50.0)) is None
     assert split_of(200.0, 240.0, (250.0, 310.0)) == "train"
-    print("prepare self-test: 3 passed, 0 failed")
+    # The reference sets of fine.py are no stages: their names never collide with STAGES
+    # (which must stay the pipeline's stage table), and their own rules hold.
+    import fine
+
+    assert not {s["name"] for s in STAGES} & {s["name"] for s in fine.FINE_SETS}
+    passed = fine.self_test_rules()
+    print(f"prepare self-test: {3 + 1 + passed} passed, 0 failed")
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--self-test", action="store_true", help="test the split rules and exit")
     p.add_argument("--data-dir", default="data", help="holds raw/ (from fetch) and receives prepared/")
-    p.add_argument("--stage", action="append", choices=[s["name"] for s in STAGES],
-                   help="prepare only this stage (repeatable; default: all)")
+    import fine
+
+    p.add_argument("--stage", action="append", choices=[s["name"] for s in STAGES + fine.FINE_SETS],
+                   help="prepare only this stage or reference set (repeatable; default: all)")
     a = p.parse_args()
     if a.self_test:
         self_test()
         return
-    prepare(a.data_dir, a.stage or [])
+    names = a.stage or []
+    learned = [n for n in names if n in {s["name"] for s in STAGES}]
+    reference = [n for n in names if n not in learned]
+    if not names or learned:
+        prepare(a.data_dir, learned)
+    if not names or reference:
+        fine.prepare_fine(a.data_dir, reference)
 
 
 if __name__ == "__main__":
