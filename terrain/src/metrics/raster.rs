@@ -78,8 +78,51 @@ impl Raster {
     }
 
     /// Bilinear resampling to pixels of `metres` over the same extent (pixel centres aligned,
-    /// edges clamped). Downsampling by a whole factor 2 averages 2×2 blocks exactly.
+    /// edges clamped). Downsampling by a whole factor 2 averages 2×2 blocks exactly; by more
+    /// than 2, bilinear taps alone would alias the short wavelengths back into the spectrum
+    /// (40 m blocks judged at 93 m), so the raster is first blurred with the Gaussian the real
+    /// sets get in `scripts/data/geo.py` (σ = (f − 1)/2 source pixels).
     pub fn resample(&self, metres: f64) -> Raster {
+        let scale = metres / self.metres;
+        if scale > 2.0 + 1e-9 {
+            let blurred = self.gaussian_blur((scale - 1.0) / 2.0);
+            return blurred.bilinear(metres);
+        }
+        self.bilinear(metres)
+    }
+
+    /// Separable Gaussian blur of standard deviation `sigma` pixels, edges clamped (the
+    /// `nearest` mode of the real sets' blur).
+    pub fn gaussian_blur(&self, sigma: f64) -> Raster {
+        let radius = (3.0 * sigma).ceil() as i64;
+        let weights: Vec<f64> = (-radius..=radius).map(|d| (-0.5 * (d as f64 / sigma).powi(2)).exp()).collect();
+        let total: f64 = weights.iter().sum();
+        let pass = |src: &[f32], n_rows: usize, n_cols: usize, along_rows: bool| -> Vec<f32> {
+            (0..n_rows * n_cols)
+                .map(|i| {
+                    let (r, c) = ((i / n_cols) as i64, (i % n_cols) as i64);
+                    let sum: f64 = (-radius..=radius)
+                        .zip(&weights)
+                        .map(|(d, w)| {
+                            let (rr, cc) = if along_rows {
+                                ((r + d).clamp(0, n_rows as i64 - 1), c)
+                            } else {
+                                (r, (c + d).clamp(0, n_cols as i64 - 1))
+                            };
+                            w * src[rr as usize * n_cols + cc as usize] as f64
+                        })
+                        .sum();
+                    (sum / total) as f32
+                })
+                .collect()
+        };
+        let across = pass(&self.data, self.rows, self.cols, false);
+        let data = pass(&across, self.rows, self.cols, true);
+        Raster { rows: self.rows, cols: self.cols, metres: self.metres, data }
+    }
+
+    /// Bilinear taps only (see [`Raster::resample`]).
+    fn bilinear(&self, metres: f64) -> Raster {
         let scale = metres / self.metres;
         let rows = ((self.rows as f64 / scale).floor() as usize).max(1);
         let cols = ((self.cols as f64 / scale).floor() as usize).max(1);
@@ -126,5 +169,27 @@ mod tests {
         assert_eq!((up.rows, up.cols), (18, 18));
         let (a, b) = (up.at(5, 5), up.at(5, 7));
         assert!(((b - a) - 2.0).abs() < 1e-5, "plane slope lost: {a} {b}");
+    }
+
+    #[test]
+    fn downsampling_by_more_than_two_blurs_away_what_the_new_grid_cannot_hold() {
+        // A checkerboard (the shortest wavelength there is) is damped to a fraction of what
+        // bilinear taps alone keep of it as a coarse pattern (away from the clamped edges); a
+        // plane stays a plane.
+        let checker = Raster::from_fn(64, 64, 40.0, |y, x| if (y + x) % 2 == 0 { 100.0 } else { -100.0 });
+        let coarse = checker.resample(93.0);
+        let worst = |r: &Raster| {
+            (1..r.rows - 1)
+                .flat_map(|y| (1..r.cols - 1).map(move |x| (y, x)))
+                .map(|(y, x)| r.at(y, x).abs())
+                .fold(0.0f32, f32::max)
+        };
+        let aliased = worst(&checker.bilinear(93.0));
+        assert!(aliased > 30.0, "bilinear taps alone keep {aliased} m");
+        assert!(worst(&coarse) < 0.2 * aliased, "aliased: {} m away from the edges", worst(&coarse));
+        let plane = Raster::from_fn(64, 64, 40.0, |y, x| 3.0 * x as f32 + y as f32);
+        let p = plane.resample(93.0);
+        let step = p.at(10, 11) - p.at(10, 10);
+        assert!((step - 3.0 * 93.0 / 40.0).abs() < 1e-3, "plane slope lost: {step}");
     }
 }
