@@ -67,6 +67,20 @@ pub struct EvalArgs {
     /// report's generated values and realism bar (needs a reference with a train split).
     #[arg(long)]
     pub record: Option<PathBuf>,
+    /// Leave out generated tiles with less land (above 0 m) than this fraction, e.g. 0.99
+    /// against a land-only reference such as `data/prepared/fine-93m`.
+    #[arg(long, default_value_t = 0.0, value_parser = fraction)]
+    pub min_land: f64,
+}
+
+/// A fraction in 0 ..= 1.
+fn fraction(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?} is not a number: {e}"))?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a fraction between 0 and 1"))
+    }
 }
 
 impl From<&EvalArgs> for EvalOptions {
@@ -77,6 +91,7 @@ impl From<&EvalArgs> for EvalOptions {
             out: a.out.clone(),
             seam_stride: a.seam_stride,
             record: a.record.clone(),
+            min_land: a.min_land,
         }
     }
 }

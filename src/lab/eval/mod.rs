@@ -42,6 +42,9 @@ pub struct EvalOptions {
     /// Model manifest (e.g. `models/core.json`) whose `realism` numbers are replaced by this
     /// report's generated values and realism bar (needs a reference with a train split).
     pub record: Option<PathBuf>,
+    /// Generated tiles with less land than this fraction (above 0 m) are left out: a land-only
+    /// reference (the block-scale sets) is judged against generated land, not coast and sea.
+    pub min_land: f64,
 }
 
 /// Why an evaluation failed.
@@ -110,9 +113,18 @@ pub fn run(args: &EvalOptions, progress: &mut dyn FnMut(u64, u64)) -> Result<Rep
         }
     }
     let (metres, size) = (reference.metres(), reference.tile);
-    let gen_tiles = generated.tiles_at(metres, size);
+    let all_tiles = generated.tiles_at(metres, size);
+    let cut = all_tiles.len();
+    let gen_tiles: Vec<Raster> = all_tiles.into_iter().filter(|t| land_fraction(t) >= args.min_land).collect();
     if gen_tiles.is_empty() {
-        return Err(EvalError::Input(format!("{} yields no tile to measure", args.generated.display())));
+        return Err(EvalError::Input(format!(
+            "{} yields no tile to measure ({cut} tiles, none with at least {} land)",
+            args.generated.display(),
+            args.min_land
+        )));
+    }
+    if gen_tiles.len() < cut {
+        eprintln!("{} of {cut} generated tiles have less than {} land: left out", cut - gen_tiles.len(), args.min_land);
     }
     let ref_tiles = reference.heldout.tiles_at(metres, size);
     let train_tiles = reference.train.as_ref().map(|t| t.tiles_at(metres, size)).unwrap_or_default();
@@ -183,6 +195,11 @@ fn record(path: &Path, report: &Report) -> Result<(), EvalError> {
         Ok(())
     })
     .map_err(|e| EvalError::Input(format!("--record: {e:#}")))
+}
+
+/// Fraction of a tile above the sea.
+fn land_fraction(t: &Raster) -> f64 {
+    t.data.iter().filter(|&&v| v > measure::SEA_LEVEL_M).count() as f64 / t.data.len().max(1) as f64
 }
 
 /// The generated map's seam sums on its own window lines (whole map: its origin places the

@@ -47,6 +47,7 @@ fn args(generated: &Path, reference: &Path, out: &Path) -> EvalOptions {
         out: out.into(),
         seam_stride: 32,
         record: None,
+        min_land: 0.0,
     }
 }
 
@@ -173,6 +174,31 @@ fn eval_measures_generated_fbm_and_real_and_writes_the_image() {
     assert_eq!(panels, 3, "a train split adds the real-vs-real panel");
     assert_eq!(img.width() % panels, 0, "{} px for {panels} panels", img.width());
     assert!(img.width() / panels >= 500);
+}
+
+#[test]
+fn generated_tiles_with_too_little_land_are_left_out_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = prepared_set(dir.path(), 2);
+    let generated = dir.path().join("gen.npy");
+    write_generated(&generated, 256);
+    // Sink the west half under the sea: two of the four 1 km tiles become sea.
+    let (_, mut data) = crate::npy::read_npy_f32(&generated).unwrap();
+    data.chunks_mut(256).for_each(|row| row[..128].iter_mut().for_each(|v| *v -= 5000.0));
+    write_npy_f32(&generated, (256, 256), &data).unwrap();
+    let out = dir.path().join("eval.png");
+    let all = run(&args(&generated, &set, &out), &mut |_, _| {}).unwrap();
+    assert_eq!(all.get("tiles", 1), Some("4"));
+    let land = run(&EvalOptions { min_land: 0.99, ..args(&generated, &set, &out) }, &mut |_, _| {}).unwrap();
+    assert_eq!(land.get("tiles", 1), Some("2"));
+    assert_eq!(land.get("land fraction (> 0 m)", 1), Some("1.00"));
+    let none = run(&EvalOptions { min_land: 1.0, ..args(&generated, &set, &out) }, &mut |_, _| {});
+    data.iter_mut().for_each(|v| *v -= 5000.0);
+    write_npy_f32(&generated, (256, 256), &data).unwrap();
+    let none_at_all = run(&EvalOptions { min_land: 0.5, ..args(&generated, &set, &out) }, &mut |_, _| {});
+    assert!(none.is_ok(), "the two land tiles are wholly land");
+    let err = none_at_all.expect_err("an all-sea map has no land tile").to_string();
+    assert!(err.contains("gen.npy") && err.contains("none with at least 0.5 land"), "{err}");
 }
 
 #[test]
