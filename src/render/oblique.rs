@@ -108,7 +108,7 @@ pub fn render_oblique(
             pipeline.seed()
         ),
         format!(
-            "x {}..{}, z {}..{} ({}×{} blocks); north-east is up-right",
+            "x {}..{}, z {}..{} ({}×{} blocks); east runs up-right, south down-right",
             req.x0,
             req.x0 + req.width,
             req.z0,
