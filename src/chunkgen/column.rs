@@ -125,6 +125,31 @@ impl Generator {
         SurfaceSample { y, biome: biome.to_string(), top: top.to_kind().to_str() }
     }
 
+    /// The surface of every column of `rect` (row-major: z rows, x within a row), each exactly
+    /// as [`surface`](Self::surface) reports it, from one pipeline query: pictures of whole
+    /// areas would otherwise pay a query per column.
+    pub fn surfaces(&self, rules: &BiomeRules, rect: Rect) -> Vec<SurfaceSample> {
+        // Whole biome cells with one column of border: every sample column and every
+        // column's neighbours (for its steepness) lie inside.
+        let (cx0, cz0) = (rect.x0.div_euclid(CELL), rect.y0.div_euclid(CELL));
+        let (cx1, cz1) = ((rect.x1() - 1).div_euclid(CELL) + 1, (rect.y1() - 1).div_euclid(CELL) + 1);
+        let padded = Rect::new(cz0 * CELL - 1, cx0 * CELL - 1, (cz1 - cz0) * CELL + 2, (cx1 - cx0) * CELL + 2);
+        let columns = Columns::query(&self.pipeline, &self.vertical, padded);
+        let mut out = Vec::with_capacity(rect.area());
+        for z in rect.y0..rect.y1() {
+            for x in rect.x0..rect.x1() {
+                let biome = self.surface_biome(rules, &columns, x, z);
+                let top = self.ground_at(&columns, biome, x, z).top;
+                out.push(SurfaceSample {
+                    y: columns.surface_y(x, z),
+                    biome: biome.to_string(),
+                    top: top.to_kind().to_str(),
+                });
+            }
+        }
+        out
+    }
+
     /// The ground of column (`x`, `z`) in `biome` (top and filler, by water depth, steepness
     /// and temperature).
     pub(super) fn ground_at(&self, columns: &Columns, biome: &str, x: i64, z: i64) -> Ground {
@@ -159,6 +184,22 @@ fn tree_rect(x0: i64, z0: i64, size: i64) -> Rect {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn surfaces_of_an_area_agree_with_the_column_queries() {
+        let config = crate::config::Config::default();
+        let pipeline = std::sync::Arc::new(crate::terrain::Pipeline::new(3, &config.terrain()));
+        let g = Generator::new(pipeline, &config);
+        let rules = BiomeRules::load_dir(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("biomes")).unwrap();
+        // Not aligned to biome cells on any side.
+        let rect = Rect::new(-7, 5, 6, 9);
+        let all = g.surfaces(&rules, rect);
+        assert_eq!(all.len(), 54);
+        for (i, s) in all.iter().enumerate() {
+            let (x, z) = (rect.x0 + (i % 9) as i64, rect.y0 + (i / 9) as i64);
+            assert_eq!(*s, g.surface(&rules, x, z), "({x}, {z})");
+        }
+    }
 
     #[test]
     fn a_chunk_needs_four_columns_of_border_and_any_square_its_cells() {

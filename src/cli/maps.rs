@@ -2,14 +2,14 @@
 
 use std::path::PathBuf;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 
 use super::progress::Progress;
 use super::{world_sources, Failure, Size, Sources};
 use crate::chunkgen::Generator;
 use crate::config::Config;
 use crate::export::{self, ExportRequest, Grid, Vertical};
-use crate::render::{self, Layer, RenderRequest};
+use crate::render::{self, CompareRequest, Layer, ObliqueRequest, RenderRequest};
 use crate::terrain::model_files::ModelFiles;
 use crate::terrain::Pipeline;
 
@@ -39,6 +39,17 @@ pub struct RenderArgs {
     /// What to draw: elevation, temperature, precipitation, seasonality, variability, biome.
     #[arg(long, default_value = "elevation")]
     pub layer: Layer,
+    /// `map`: seen from straight above, one colour per pixel; `oblique`: the block columns as
+    /// a player sees them from above at an angle (from the south-west, one block up as long as
+    /// one across), coloured by their top blocks.
+    #[arg(long, value_enum, default_value_t = View::Map)]
+    pub view: View,
+    /// Draw a relief comparison instead of a map: hillshades of generated mountains, hills
+    /// and plains (the highest, median and lowest relief among windows of the rectangle)
+    /// beside tiles of this prepared set (`data/prepared/NAME`) picked alike, at one block per
+    /// pixel.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["view", "zoom", "layer"])]
+    pub compare_real: Option<PathBuf>,
     /// Output PNG.
     #[arg(long)]
     pub out: PathBuf,
@@ -46,6 +57,15 @@ pub struct RenderArgs {
     /// else the built-in rules).
     #[arg(long)]
     pub biomes: Option<PathBuf>,
+}
+
+/// How `render` looks at the world.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum View {
+    /// From straight above.
+    Map,
+    /// From above at an angle, block columns as voxels.
+    Oblique,
 }
 
 /// Arguments of `infiniterra export`.
@@ -81,6 +101,34 @@ pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), 
     if a.zoom < 1 {
         return Err(Failure::input(anyhow::anyhow!("--zoom {} is out of range (allowed 1 or more)", a.zoom)));
     }
+    let (x0, z0, width, height) = (a.area.x0, a.area.z0, a.area.size.width, a.area.size.height);
+    if let Some(real) = &a.compare_real {
+        let req = CompareRequest { x0, z0, width, height };
+        let mut progress = Progress::new("render", "rows of windows");
+        let image = render::render_relief_comparison(&pipeline(config, &models)?, real, &req, &mut |d, t| {
+            progress.update(d, t)
+        })
+        .map_err(|e| classify(e.is_bad_input(), e))?;
+        progress.finish();
+        return save(&image, &a.out);
+    }
+    if a.view == View::Oblique {
+        if a.zoom != 1 || a.layer != Layer::Elevation {
+            return Err(Failure::input(anyhow::anyhow!(
+                "--view oblique draws every block column with its top block: --zoom and --layer do not apply"
+            )));
+        }
+        let rules = rules.load().map_err(Failure::input)?;
+        let generator = Generator::new(std::sync::Arc::new(pipeline(config, &models)?), config);
+        let mut progress = Progress::new("render", "rows of columns");
+        let image =
+            render::render_oblique(&generator, &rules, &ObliqueRequest { x0, z0, width, height }, &mut |d, t| {
+                progress.update(d, t)
+            })
+            .map_err(|e| classify(e.is_bad_input(), e))?;
+        progress.finish();
+        return save(&image, &a.out);
+    }
     let req = RenderRequest {
         x0: a.area.x0,
         z0: a.area.z0,
@@ -99,8 +147,12 @@ pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), 
     }
     .map_err(|e| classify(e.is_bad_input(), e))?;
     progress.finish();
-    render::save_png(&image, &a.out).map_err(Failure::runtime)?;
-    println!("wrote {} ({}×{} px)", a.out.display(), image.width(), image.height());
+    save(&image, &a.out)
+}
+
+fn save(image: &image::RgbImage, out: &std::path::Path) -> Result<(), Failure> {
+    render::save_png(image, out).map_err(Failure::runtime)?;
+    println!("wrote {} ({}×{} px)", out.display(), image.width(), image.height());
     Ok(())
 }
 

@@ -96,11 +96,18 @@ pub fn render_biomes(
         progress(py as u64 + 1, height as u64);
     }
     let pipeline = generator.pipeline();
-    Ok(frame(map, &title_lines(req, pipeline.seed(), &pipeline.active_stages(), pipeline.block_metres()), counts))
+    let title = title_lines(req, pipeline.seed(), &pipeline.active_stages(), pipeline.block_metres());
+    Ok(frame(map, &title, counts, colour))
 }
 
-/// The map above a panel with the title and one swatch per biome, most common first.
-fn frame(map: RgbImage, title: &[String], counts: HashMap<String, u64>) -> RgbImage {
+/// The map above a panel with the title and one swatch per named thing (biome, block),
+/// most common first, coloured by `colour`.
+pub(crate) fn frame(
+    map: RgbImage,
+    title: &[String],
+    counts: HashMap<String, u64>,
+    colour: impl Fn(&str) -> Rgb<u8>,
+) -> RgbImage {
     let mut biomes: Vec<(String, u64)> = counts.into_iter().collect();
     biomes.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
     let frame_width = map.width().max(panel::MIN_FRAME_WIDTH);

@@ -7,8 +7,10 @@
 
 mod biomes;
 mod layer;
+mod oblique;
 mod panel;
 mod ramp;
+mod relief_compare;
 mod sample;
 mod shade;
 
@@ -18,6 +20,8 @@ use image::{Rgb, RgbImage};
 
 pub use biomes::render_biomes;
 pub use layer::{Layer, UnknownLayer};
+pub use oblique::{render_oblique, ObliqueRequest, MAX_OBLIQUE_SIDE};
+pub use relief_compare::{render_relief_comparison, CompareRequest};
 
 use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL};
 use crate::terrain::tile::div_ceil;
@@ -83,6 +87,23 @@ pub enum RenderError {
         /// [`MAX_IMAGE_SIDE`].
         max: i64,
     },
+    /// An oblique view larger than [`MAX_OBLIQUE_SIDE`] on a side.
+    #[error("a {width}x{height}-block oblique view is too large; the most is {max} blocks per side")]
+    ViewTooLarge {
+        /// Width asked for, blocks.
+        width: i64,
+        /// Height asked for, blocks.
+        height: i64,
+        /// [`MAX_OBLIQUE_SIDE`].
+        max: i64,
+    },
+    /// The real elevation set of a relief comparison is missing or malformed (the message
+    /// names the file).
+    #[error("{0}")]
+    Real(String),
+    /// No window of the searched area (or no real tile) is usable for a relief comparison.
+    #[error("{0}")]
+    NoWindows(String),
     /// The region runs past the range of block coordinates.
     #[error("the region x {x0}+{width}, z {z0}+{height} runs past the range of block coordinates")]
     OutOfRange {
