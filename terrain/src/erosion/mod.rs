@@ -38,6 +38,11 @@ pub const HURST: f64 = 0.9;
 pub const FLOOR_SLOPE: f64 = 0.005;
 /// How strongly an octave's slopes turn the next octave's downhill direction.
 const STEER: f64 = 1.0;
+/// Turn between the lattices of successive octaves, radians (the golden angle: no two
+/// octaves of the ladder share an orientation).
+const GOLDEN_ANGLE: f64 = 2.399_963_229_728_653;
+/// Turn of the first octave's lattice, radians (off the world's axes).
+const LATTICE_ANGLE: f64 = 0.5;
 /// Octaves that exist at all (wavelength 4 km down to ≈ 1 m).
 pub const MAX_OCTAVES: u32 = 12;
 
@@ -94,11 +99,19 @@ impl ErosionFilter {
             let norm = gx.hypot(gz);
             // Downhill; on dead-flat ground any fixed direction will do.
             let dir = if norm > 1e-12 { (-gx / norm, -gz / norm) } else { (1.0, 0.0) };
-            let g = gullies(splitmix(self.seed ^ u64::from(k)), x / lambda, z / lambda, dir);
+            // Each octave's lattice is turned by its own angle: the noise's cells are squares,
+            // and on one common axis-aligned lattice their edges line up into straight
+            // north-south and east-west lines across the hillshade.
+            let (sin, cos) = (f64::from(k) * GOLDEN_ANGLE + LATTICE_ANGLE).sin_cos();
+            let turn = |(a, b): (f64, f64)| (cos * a - sin * b, sin * a + cos * b);
+            let (px, pz) = turn((x / lambda, z / lambda));
+            let g = gullies(splitmix(self.seed ^ u64::from(k)), px, pz, turn(dir));
+            // Back from the lattice's frame (the inverse turn) for the derivatives.
+            let (dx, dz) = (cos * g.dx + sin * g.dz, -sin * g.dx + cos * g.dz);
             let amp = amplitude(lambda, slope);
             height += amp * g.value;
-            gx += STEER * amp * g.dx / lambda;
-            gz += STEER * amp * g.dz / lambda;
+            gx += STEER * amp * dx / lambda;
+            gz += STEER * amp * dz / lambda;
         }
         Carved { height, gradient: (gx, gz) }
     }
@@ -112,9 +125,16 @@ struct Gully {
     dz: f64,
 }
 
+/// Reach of a lattice point's weight, lattice units: every point this close to a query lies
+/// in its 4×4 neighbourhood (points sit jittered by at most half a cell), and one always does.
+const REACH: f64 = 1.5;
+
 /// Gully noise at (`px`, `pz`) in lattice units: a cosine stripe through every jittered
-/// lattice point whose crests run along `dir` (unit, downhill), blended with Gaussian
-/// weights over the 4×4 nearest points. In [−1, 1].
+/// lattice point whose crests run along `dir` (unit, downhill), blended over the 4×4 nearest
+/// points with weights (1 − r²/[`REACH`]²)⁴ — as narrow as a Gaussian of σ = ½ near the point,
+/// but exactly zero before a point leaves the neighbourhood. (A Gaussian's 1 % tail, cut off at
+/// the cell lines, left steps of metres along a straight lattice there, visible in hillshades.)
+/// In [−1, 1].
 fn gullies(seed: u64, px: f64, pz: f64, dir: (f64, f64)) -> Gully {
     let (ix, iz) = (px.floor(), pz.floor());
     let (fx, fz) = (px - ix, pz - iz);
@@ -131,7 +151,7 @@ fn gullies(seed: u64, px: f64, pz: f64, dir: (f64, f64)) -> Gully {
             let jx = (h >> 40) as f64 / (1u64 << 24) as f64;
             let jz = ((h >> 16) & 0xFF_FFFF) as f64 / (1u64 << 24) as f64;
             let (ox, oz) = (fx - (i as f64 + 0.5 * jx), fz - (j as f64 + 0.5 * jz));
-            let w = (-2.0 * (ox * ox + oz * oz)).exp();
+            let w = (1.0 - (ox * ox + oz * oz) / (REACH * REACH)).max(0.0).powi(4);
             let (s, c) = (TAU * (ox * across.0 + oz * across.1)).sin_cos();
             value += c * w;
             dx -= s * TAU * across.0 * w;

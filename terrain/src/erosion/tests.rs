@@ -64,3 +64,31 @@ fn gullies_run_downhill() {
     }
     assert!(across > 4.0 * along, "across {across} along {along}");
 }
+
+#[test]
+fn the_carving_is_continuous_across_every_octave_s_lattice_lines() {
+    // Straight across the cell lines of each octave's lattice, a hair to either side: the
+    // height must not step (a kernel whose tail is cut at the neighbourhood's edge would leave
+    // steps of a per cent of the octave's amplitude, drawn as straight lines in a hillshade).
+    let filter = ErosionFilter::new(3);
+    let (slope, gradient) = (0.3, (0.2, -0.2));
+    for k in 0..6 {
+        let lambda = wavelength(k);
+        let amp = amplitude(lambda, slope);
+        // A point given in the octave's (turned) lattice frame, in world metres.
+        let (sin, cos) = (f64::from(k) * GOLDEN_ANGLE + LATTICE_ANGLE).sin_cos();
+        let world = |a: f64, b: f64| ((cos * a + sin * b) * lambda, (-sin * a + cos * b) * lambda);
+        let at = |(x, z): (f64, f64)| filter.apply(x, z, slope, gradient, k..k + 1).height;
+        let eps = 1e-7;
+        for n in -20..20 {
+            let line = f64::from(n);
+            for along in [0.13, 0.37, 0.71] {
+                let other = f64::from(n) + along;
+                let step_a = (at(world(line + eps, other)) - at(world(line - eps, other))).abs();
+                let step_b = (at(world(other, line + eps)) - at(world(other, line - eps))).abs();
+                let step = step_a.max(step_b);
+                assert!(step < 1e-4 * amp, "octave {k}: a step of {step} m on a lattice line");
+            }
+        }
+    }
+}
