@@ -43,7 +43,9 @@ fn steep_relief_is_carved_deeper_than_plains() {
     let hills = rms(&field(&f, 0.1, (0.1, 0.0), 0..6));
     let mountains = rms(&field(&f, 0.5, (0.5, 0.0), 0..6));
     assert!(plain < 15.0, "plains keep a few metres: {plain}");
-    assert!(hills > 4.0 * plain && mountains > 4.0 * hills, "{plain} {hills} {mountains}");
+    assert!(hills > 4.0 * plain && mountains > 2.5 * hills, "{plain} {hills} {mountains}");
+    // Less than in proportion to the slope (5× steeper): hillslopes stop steepening.
+    assert!(mountains < 4.0 * hills, "{hills} {mountains}");
 }
 
 #[test]
