@@ -439,3 +439,51 @@ fn timed_chunks_are_the_same_chunks_and_time_every_pass_in_order() {
         }
     }
 }
+
+/// Seed 1's generator at `metres_per_block`, with the shipped biome rules.
+fn generator_at(metres_per_block: f64) -> (Generator, BiomeRules) {
+    let mut config = Config::default();
+    config.world.metres_per_block = metres_per_block;
+    let g = Generator::new(Arc::new(Pipeline::new(config.world.seed, &config.terrain())), &config);
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("biomes");
+    (g, BiomeRules::load_dir(&dir).expect("the shipped rules load"))
+}
+
+#[test]
+fn at_30_40_and_125_metres_per_block_spawn_climate_rock_trees_and_biomes_still_behave() {
+    for scale in [30.0, 40.0, 125.0] {
+        let (g, rules) = generator_at(scale);
+        let v = *g.vertical();
+        // Spawn: dry land above the sea.
+        let spawn = crate::world::find_spawn(&g, &rules).block;
+        let at_spawn = g.surface(&rules, i64::from(spawn.x), i64::from(spawn.z));
+        assert!(at_spawn.y > v.sea_level_y && at_spawn.top != "water", "{scale} m: spawn {spawn:?} {at_spawn:?}");
+        // The high range of the default world (the same metres at every scale): rock on its
+        // steep faces, plants on its gentler ground, colder on the heights.
+        let block = |m: f64| (m / scale).round() as i64;
+        let range = Rect::new(block(-271_360.0) - 64, block(291_840.0) - 64, 128, 128);
+        let tops = g.surfaces(&rules, range);
+        let count = |names: &[&str]| tops.iter().filter(|s| names.contains(&s.top)).count();
+        let rock = count(&["stone", "andesite", "gravel", "terracotta", "snow_block", "powder_snow"]);
+        let green = count(&["grass_block", "podzol", "coarse_dirt", "mud"]);
+        assert!(rock > 100 && green > 100, "{scale} m: {rock} rock and {green} green tops in the range");
+        let columns = Columns::query(g.pipeline(), &v, range);
+        let (high, low) = rect_columns(range).fold(((f32::MIN, 0.0), (f32::MAX, 0.0)), |(hi, lo), (x, z)| {
+            let (e, t) = (columns.elevation(x, z), columns.get(channel::TEMPERATURE, x, z));
+            (if e > hi.0 { (e, t) } else { hi }, if e < lo.0 { (e, t) } else { lo })
+        });
+        assert!(high.0 - low.0 > 500.0 && high.1 < low.1 - 2.0, "{scale} m: {low:?} .. {high:?} (m, °C)");
+        // Biomes vary over ~100 km around the spawn, and forests grow trees.
+        let step = block(12_000.0);
+        let biomes: std::collections::HashSet<String> = (-4..=4)
+            .flat_map(|i| (-4..=4).map(move |j| (i, j)))
+            .map(|(i, j)| g.surface(&rules, i64::from(spawn.x) + i * step, i64::from(spawn.z) + j * step).biome)
+            .collect();
+        assert!(biomes.len() >= 4, "{scale} m: only {biomes:?} over 100 km");
+        let forest = BiomeRules::from_sources(&[(PathBuf::from("f.toml"), "fallback = \"minecraft:forest\"\n".into())])
+            .expect("forest rules");
+        let near = Rect::new(i64::from(spawn.z) - 32, i64::from(spawn.x) - 32, 64, 64);
+        let trees = rect_columns(near).filter(|&(x, z)| !g.clear_of_trees(&forest, x, z)).count();
+        assert!(trees > 50, "{scale} m: {trees} columns under trees by the spawn");
+    }
+}
