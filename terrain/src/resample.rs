@@ -28,7 +28,7 @@ pub fn source_rect(target: &Rect, ratio: f64, reach: i64) -> Rect {
 
 /// Index of the source cell below each target pixel (relative to `origin`) and the fraction
 /// toward the next one.
-fn taps(d0: i64, n: i64, ratio: f64, origin: i64) -> Vec<(usize, f64)> {
+fn taps(d0: i64, n: i64, ratio: f64, origin: i64) -> Taps {
     (d0..d0 + n)
         .map(|d| {
             let u = coord(d, ratio);
@@ -38,9 +38,13 @@ fn taps(d0: i64, n: i64, ratio: f64, origin: i64) -> Vec<(usize, f64)> {
         .collect()
 }
 
+/// One axis's taps: for each target index, the source index at or before it and the fraction
+/// toward the next.
+type Taps = Vec<(usize, f64)>;
+
 /// The row and column taps of `target` on `source`, which must cover
 /// [`source_rect`]`(target, ratio, reach)`.
-fn plan(source: &Tile, ratio: f64, target: Rect, reach: i64) -> (Vec<(usize, f64)>, Vec<(usize, f64)>) {
+fn plan(source: &Tile, ratio: f64, target: Rect, reach: i64) -> (Taps, Taps) {
     let need = source_rect(&target, ratio, reach);
     assert!(source.rect.contains_rect(&need), "resampling {target:?} needs {need:?}, got {:?}", source.rect);
     (taps(target.y0, target.h, ratio, source.rect.y0), taps(target.x0, target.w, ratio, source.rect.x0))
