@@ -9,7 +9,8 @@ use super::{world_sources, Failure, Size, Sources};
 use crate::chunkgen::Generator;
 use crate::config::Config;
 use crate::export::{self, ExportRequest, Grid, Vertical};
-use crate::render::{self, CompareRequest, Layer, ObliqueRequest, RenderRequest};
+use crate::lab::relief_compare::{self, CompareRequest};
+use crate::render::{self, Layer, ObliqueRequest, RenderRequest};
 use crate::terrain::model_files::ModelFiles;
 use crate::terrain::Pipeline;
 
@@ -105,7 +106,7 @@ pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), 
     if let Some(real) = &a.compare_real {
         let req = CompareRequest { x0, z0, width, height };
         let mut progress = Progress::new("render", "rows of windows");
-        let image = render::render_relief_comparison(&pipeline(config, &models)?, real, &req, &mut |d, t| {
+        let image = relief_compare::render_relief_comparison(&pipeline(config, &models)?, real, &req, &mut |d, t| {
             progress.update(d, t)
         })
         .map_err(|e| classify(e.is_bad_input(), e))?;

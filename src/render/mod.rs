@@ -8,11 +8,10 @@
 mod biomes;
 mod layer;
 mod oblique;
-mod panel;
-mod ramp;
-mod relief_compare;
+pub(crate) mod panel;
+pub(crate) mod ramp;
 mod sample;
-mod shade;
+pub(crate) mod shade;
 
 use std::path::{Path, PathBuf};
 
@@ -21,7 +20,6 @@ use image::{Rgb, RgbImage};
 pub use biomes::render_biomes;
 pub use layer::{Layer, UnknownLayer};
 pub use oblique::{render_oblique, ObliqueRequest, MAX_OBLIQUE_SIDE};
-pub use relief_compare::{render_relief_comparison, CompareRequest};
 
 use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL};
 use crate::terrain::tile::div_ceil;

@@ -33,9 +33,9 @@ pub const LONGEST_M: f64 = 4000.0;
 pub const AMPLITUDE: f64 = 0.35;
 /// Hurst exponent of the octave amplitudes: each halving of the wavelength keeps 2^−H of the
 /// amplitude. Real 3″ DEMs judged on 6 km tiles at 93 m fall off as β ≈ −4.4 (H ≈ 1.2; the
-/// 0.8–0.9 of the literature holds over longer ranges); 1.1 puts the block grid's β inside
+/// 0.8–0.9 of the literature holds over longer ranges); 1.2 puts the block grid's β inside
 /// the real tiles' range ± 0.3 for hills and mountains (docs/realism.md, "The block grid").
-pub const HURST: f64 = 1.1;
+pub const HURST: f64 = 1.2;
 /// Slope (m/m) below which a plain is treated as this steep, so flat land keeps a few metres
 /// of relief instead of none.
 pub const FLOOR_SLOPE: f64 = 0.005;
@@ -46,6 +46,12 @@ const STEER: f64 = 1.0;
 const GOLDEN_ANGLE: f64 = 2.399_963_229_728_653;
 /// Turn of the first octave's lattice, radians (off the world's axes).
 const LATTICE_ANGLE: f64 = 0.5;
+/// Shortest wavelength a resampled grid carries, in its own pixels. The model grid is
+/// upsampled 4× to blocks by a cubic; octaves of a few of its pixels come out of that with a
+/// beat of the grid's period — block steps midway between model-pixel centres 8–10 % larger
+/// than across them (4-block facets) with octaves down to 2 or 4 pixels — so everything
+/// shorter than 8 pixels is carved on the block grid itself.
+pub const SHORTEST_ON_GRID_PIXELS: f64 = 8.0;
 /// Octaves that exist at all (wavelength 4 km down to ≈ 1 m).
 pub const MAX_OCTAVES: u32 = 12;
 

@@ -24,15 +24,18 @@ fn the_same_point_gives_the_same_bits_and_seeds_differ() {
 
 #[test]
 fn octave_bands_split_the_ladder_without_gap_or_overlap() {
-    // The model grid takes wavelengths ≥ 2 grid pixels, blocks the rest down to 2 blocks.
+    // The model grid (4 blocks) takes wavelengths of 4 grid pixels and more, blocks the rest
+    // down to 2 blocks.
     for block in [15.0, 40.0, 125.0, 250.0] {
-        let grid = octaves_between(8.0 * block, f64::INFINITY);
-        let blocks = octaves_between(2.0 * block, 8.0 * block);
+        let grid = octaves_between(SHORTEST_ON_GRID_PIXELS * 4.0 * block, f64::INFINITY);
+        let blocks = octaves_between(2.0 * block, SHORTEST_ON_GRID_PIXELS * 4.0 * block);
         assert_eq!(grid.start, 0);
         assert_eq!(grid.end, blocks.start, "{block} m/block");
         assert!(wavelength(blocks.end - 1) >= 2.0 * block);
         assert!(blocks.end == MAX_OCTAVES || wavelength(blocks.end) < 2.0 * block);
-        assert_eq!(blocks.len(), 2, "two octaves below the 4-block grid at {block} m/block");
+        // Octaves halve: log2(shortest on the grid / 2 blocks) of them on the blocks.
+        let below = (SHORTEST_ON_GRID_PIXELS * 4.0 / 2.0).log2().round() as usize;
+        assert_eq!(blocks.len(), below, "octaves from 2 blocks to the grid's shortest at {block} m/block");
     }
 }
 

@@ -1,10 +1,10 @@
 //! The model grid (4 blocks a pixel, at any world scale): the finest stage that ran,
-//! resampled to it by a cubic, with the erosion filter's octaves that the grid can hold
-//! (wavelengths of two pixels and more).
+//! resampled to it by a cubic, with the erosion filter's octaves that the grid holds well
+//! (wavelengths of [`SHORTEST_ON_GRID_PIXELS`] pixels and more).
 
 use std::sync::Arc;
 
-use crate::erosion::{octaves_between, ErosionFilter};
+use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
 use crate::infinite::Source;
 use crate::resample;
 use crate::tile::{Rect, Tile};
@@ -32,7 +32,7 @@ impl Finest {
             ratio: metres / base_metres,
             metres,
             erosion,
-            octaves: octaves_between(2.0 * metres, f64::INFINITY),
+            octaves: octaves_between(SHORTEST_ON_GRID_PIXELS * metres, f64::INFINITY),
         }
     }
 }

@@ -4,7 +4,7 @@
 //! Owns: the stage list (coarse → core → detail, as data in [`stages::LEARNED`]), the grids
 //! they live on, the world's horizontal scale, the model grid (always 4 blocks: the finest
 //! learned grid resampled to it, plus the erosion filter's longer octaves) and the 4×
-//! upsampling from model pixels to blocks (plus the erosion filter's two shortest octaves).
+//! upsampling from model pixels to blocks (plus the erosion filter's shortest octaves).
 //! Must not touch: Minecraft (block ids, biomes, chunks) — callers map metres and climate to
 //! blocks themselves.
 
@@ -18,7 +18,7 @@ pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 
 use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
-use crate::erosion::{octaves_between, ErosionFilter};
+use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
@@ -321,9 +321,9 @@ impl Pipeline {
     }
 
     /// Block elevations of `blocks` from the model grid `finest` ([`finest`] channels, over
-    /// [`Pipeline::model_rect`]): the cubic upsampling plus the erosion octaves between 2 and
-    /// 8 blocks, steered by the model grid's gradient. Also returns the bilinear upsampling
-    /// (what the climate channels were interpolated with).
+    /// [`Pipeline::model_rect`]): the cubic upsampling plus the erosion octaves from 2 blocks
+    /// up to what the model grid carries, steered by the model grid's gradient. Also returns
+    /// the bilinear upsampling (what the climate channels were interpolated with).
     fn carve_blocks(&self, finest: &Tile, blocks: Rect) -> (Vec<f32>, Vec<f32>) {
         let inner = resample::source_rect(&blocks, BLOCK_RATIO, 1);
         let g = self.model_pixel_metres();
@@ -343,7 +343,7 @@ impl Pipeline {
         let smooth = resample::bilinear(&finest.select(&[finest::ELEVATION]), BLOCK_RATIO, blocks);
         let fields = resample::bilinear(&fields, BLOCK_RATIO, blocks);
         let b = self.block_metres();
-        let octaves = octaves_between(2.0 * b, 2.0 * g);
+        let octaves = octaves_between(2.0 * b, SHORTEST_ON_GRID_PIXELS * g);
         let n = blocks.area();
         let mut out = cubic.data;
         let mut i = 0;

@@ -111,6 +111,35 @@ fn the_erosion_filter_carves_relief_below_the_model_grid() {
 }
 
 #[test]
+fn the_block_grid_has_no_seams_on_chunk_or_model_pixel_lines() {
+    // High land at the default scale, 256² blocks: the mean height step between neighbouring
+    // columns across the lines where chunks (16 blocks) or model pixels (4 blocks) meet is the
+    // step elsewhere — no crease, no 4-block facets.
+    let p = at_scale(40.0);
+    let x = (0..4000i64).map(|i| i * 512).find(|&x| p.coarse_elevation_at_block(x, 0) > 800.0).expect("high land");
+    let (n, rect) = (256usize, Rect::new(-128, x - 128, 256, 256));
+    let e = p.elevation_columns(rect);
+    let step = |y: usize, x: usize, dy: usize, dx: usize| (e.data[(y + dy) * n + x + dx] - e.data[y * n + x]).abs();
+    for period in [16i64, 4] {
+        let (mut on, mut off) = ((0.0f64, 0usize), (0.0f64, 0usize));
+        for y in 0..n - 1 {
+            for x in 0..n - 1 {
+                // A step from column x to x + 1 crosses a line when x + 1 starts a cell.
+                for (d, crosses) in [
+                    (step(y, x, 0, 1), (rect.x0 + x as i64 + 1).rem_euclid(period) == 0),
+                    (step(y, x, 1, 0), (rect.y0 + y as i64 + 1).rem_euclid(period) == 0),
+                ] {
+                    let acc = if crosses { &mut on } else { &mut off };
+                    *acc = (acc.0 + f64::from(d), acc.1 + 1);
+                }
+            }
+        }
+        let ratio = (on.0 / on.1 as f64) / (off.0 / off.1 as f64);
+        assert!((0.93..1.07).contains(&ratio), "steps across {period}-block lines are {ratio:.3}× the others");
+    }
+}
+
+#[test]
 fn neighbouring_chunks_agree_with_one_big_query() {
     let p = pipeline(5, 64, 2);
     let big = p.columns(Rect::new(-40, -40, 80, 80));

@@ -13,9 +13,9 @@ use std::path::Path;
 
 use image::{imageops, Rgb, RgbImage};
 
-use super::{panel, ramp, shade, RenderError};
+use super::eval::Reference;
 use crate::draw;
-use crate::lab::eval::Reference;
+use crate::render::{panel, ramp, shade, RenderError};
 use crate::terrain::metrics::Raster;
 use crate::terrain::pipeline::BLOCKS_PER_MODEL_PIXEL;
 use crate::terrain::tile::div_floor;
