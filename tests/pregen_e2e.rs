@@ -127,7 +127,8 @@ fn amulet_reads_the_blocks_and_biomes_we_generate() {
     assert_eq!(chunks.len(), 64);
 
     // Sampled positions: in every chunk, two columns, each at the surface, just above it
-    // (plants, snow, water), a few blocks below it, and at the floor and near the top.
+    // (plants, snow, water), just and a few blocks below it, at the floor, in the deepslate,
+    // and near the top.
     let mut expected = Vec::new();
     let mut positions = Vec::new();
     for &(cx, cz) in &chunks {
@@ -137,7 +138,7 @@ fn amulet_reads_the_blocks_and_biomes_we_generate() {
                 let (lx, lz) = ((lx + (cx + cz).rem_euclid(4) as u32) % 16, (lz + i as u32) % 16);
                 let (x, z) = (cx * 16 + lx as i32, cz * 16 + lz as i32);
                 let surface = generator.surface(&rules, x.into(), z.into()).y;
-                for y in [min_y, surface - 5, surface, surface + 1, surface + 2, 300] {
+                for y in [min_y, min_y + 1, surface - 5, surface - 1, surface, surface + 1, surface + 2, 300] {
                     let ly = (y - min_y) as u32;
                     let block = amulet::block_name(chunk.block_state(lx, ly, lz));
                     let biome = palette.names()[chunk.biome(lx / 4, ly / 4, lz / 4).to_index()].clone();
