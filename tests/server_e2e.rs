@@ -513,3 +513,63 @@ fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_r
     server.expect_line(|l| l == "pregen: cancelled", LINE_TIMEOUT);
     assert!(server.stop().success());
 }
+
+/// Two dry columns near `spawn` with nothing growing on them (a broken block must not leave
+/// a floating plant; a placed one needs a clear spot), a few blocks apart.
+fn bare_columns(generator: &Generator, rules: &BiomeRules, spawn: (i64, i64)) -> ((i64, i64), (i64, i64)) {
+    let v = *generator.vertical();
+    let bare = |&(x, z): &(i64, i64)| {
+        generator.surface(rules, x, z).y > v.water_top_y()
+            && generator.plant_blocks(rules, x, z).is_empty()
+            && generator.clear_of_trees(rules, x, z)
+    };
+    let east: Vec<(i64, i64)> = (2..4).flat_map(|dx| (-2..=2).map(move |dz| (spawn.0 + dx, spawn.1 + dz))).collect();
+    let west: Vec<(i64, i64)> = (2..4).flat_map(|dx| (-2..=2).map(move |dz| (spawn.0 - dx, spawn.1 + dz))).collect();
+    let pick = |list: Vec<(i64, i64)>| list.into_iter().find(bare).expect("a bare column by the spawn");
+    (pick(east), pick(west))
+}
+
+#[test]
+fn a_players_edits_are_seen_by_others_and_kept_after_a_reconnect_and_a_restart() {
+    let seed = 6;
+    let keep = tempfile::tempdir().expect("temp dir");
+    let world = keep.path().join("world");
+    let config = fixtures::seeded_config(seed);
+    let rules = fixtures::shipped_rules();
+    let generator = generator(&config);
+    let spawn = find_spawn(&generator, &rules);
+    let (broken, placed_on) = bare_columns(&generator, &rules, (i64::from(spawn.block.x), i64::from(spawn.block.z)));
+    let (by, py) =
+        (generator.surface(&rules, broken.0, broken.1).y, generator.surface(&rules, placed_on.0, placed_on.1).y);
+    let at = |(x, z): (i64, i64), y: i32| format!("{x},{y},{z}");
+
+    let mut server = Server::start_with(&fixtures::shipped_biomes(), seed, &config::world_directory(&world));
+    let args = ["--break", &at(broken, by), "--place-on", &at(placed_on, py), "--block", "gold_block"];
+    let report = server.node("edit.js", &args.map(String::from));
+    assert_eq!(report["ok"], true, "{report}");
+    assert_eq!(report["game_mode"], "creative", "{report}");
+    assert_eq!(report["before"]["placed"], "air", "{report}");
+    assert_eq!(report["observer_saw"]["broken"], "air", "{report}");
+    assert_eq!(report["observer_saw"]["placed"], "gold_block", "{report}");
+
+    // What a player joining later sees, after a reconnect and after a restart: the broken
+    // column one block lower, open to the sky where the block was (its light recomputed), and
+    // the gold block on the other column.
+    let list = format!("{},{};{},{}", broken.0, broken.1, placed_on.0, placed_on.1);
+    let check = |report: &Value, when: &str| {
+        let columns = report["columns"].as_array().expect("columns");
+        let (b, p) = (&columns[0], &columns[1]);
+        assert_eq!(b["y"].as_i64(), Some(i64::from(by - 1)), "{when}: broken column {b}");
+        assert_eq!(b["sky_light_above"], 15, "{when}: the light of the broken block's place: {b}");
+        assert_eq!(
+            (p["block"].as_str(), p["y"].as_i64()),
+            (Some("gold_block"), Some(i64::from(py + 1))),
+            "{when}: {p}"
+        );
+    };
+    check(&server.probe("returning", &["--columns".into(), list.clone()]), "after a reconnect");
+    assert!(server.stop().success());
+    let mut server = Server::start_with(&fixtures::shipped_biomes(), seed, &config::world_directory(&world));
+    check(&server.probe("after_restart", &["--columns".into(), list]), "after a restart");
+    assert!(server.stop().success());
+}

@@ -17,6 +17,7 @@ macro_rules! say {
 
 mod console;
 mod dimension;
+mod edit;
 mod lifecycle;
 mod players;
 mod pregen;
@@ -129,6 +130,7 @@ pub fn serve(config: &Config, options: &ServeOptions) -> Result<(), ServeError> 
     dimension::build(&mut app);
     players::build(&mut app, config);
     stream::build(&mut app);
+    edit::build(&mut app);
     console::build(&mut app);
     pregen::build(&mut app, pregen.clone());
     lifecycle::build(&mut app, address).map_err(ServeError::Runtime)?;

@@ -58,6 +58,13 @@ struct Loaded {
 #[derive(Component, Default)]
 pub struct LightSent(HashSet<ChunkPos>);
 
+impl LightSent {
+    /// Sends the light of `pos` again (it changed).
+    pub fn forget(&mut self, pos: ChunkPos) {
+        self.0.remove(&pos);
+    }
+}
+
 /// Counters for the console's `status`.
 #[derive(Default)]
 struct Stats {
@@ -118,6 +125,13 @@ impl Streamer {
     /// Workers take chunks of `job` whenever no player chunk waits (`None`: stop doing so).
     pub fn set_pregen(&self, job: Option<Arc<Job>>) {
         self.workers.set_pregen(job);
+    }
+
+    /// The light packet of loaded chunk `pos` is now `light` (a player edited the chunk).
+    pub fn relight(&mut self, pos: ChunkPos, light: Arc<[u8]>) {
+        if let Some(loaded) = self.loaded.get_mut(&pos) {
+            loaded.light = light;
+        }
     }
 
     /// Wakes idle workers from any thread (a pre-generation task resumed).

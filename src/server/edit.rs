@@ -1,0 +1,174 @@
+//! Players' block edits: breaking and placing blocks. An edit changes the chunk every player
+//! who sees it is shown (valence sends the block update to the chunk's viewers), its sky light
+//! is computed again and resent, and the chunk is saved over its generated copy — a saved
+//! chunk is always loaded rather than generated, so the edit survives unloading, reconnects
+//! and restarts (unless `world.save_chunks` is off, when edits live only while the chunk is
+//! in memory).
+//!
+//! Creative players break a block at the first hit; survival players when their client has
+//! finished digging it (the client times the dig by the held tool, as vanilla's does). A held
+//! item that is a block is placed against the face clicked — or in place of a replaceable
+//! block (grass, water) — in its default state; survival players use one up. No item drops:
+//! valence has no item entities to drop them as.
+
+use std::collections::HashSet;
+use std::sync::Arc;
+
+use valence::interact_block::InteractBlockEvent;
+use valence::inventory::HeldItem;
+use valence::prelude::*;
+use valence::protocol::{CompressionThreshold, PacketEncoder};
+
+use super::dimension::{Palette, WorldSetup};
+use super::stream::Streamer;
+use crate::chunkgen::SkyLight;
+use crate::world::codec::Encoder;
+use crate::world::Store;
+
+/// Chunks edited this tick, saved and relit at the end of it.
+#[derive(Resource, Default)]
+struct Edited(HashSet<ChunkPos>);
+
+/// What saving an edited chunk needs.
+#[derive(Resource)]
+struct Saver {
+    store: Option<Arc<Store>>,
+    encoder: Encoder,
+    compression: CompressionThreshold,
+}
+
+/// Adds the editing systems.
+pub fn build(app: &mut App) {
+    app.init_resource::<Edited>()
+        .add_systems(PostStartup, make_saver)
+        .add_systems(Update, (dig, place, save_edited).chain());
+}
+
+fn make_saver(mut commands: Commands, setup: Res<WorldSetup>, palette: Res<Palette>, server: Res<Server>) {
+    let v = setup.generator.vertical();
+    commands.insert_resource(Saver {
+        store: setup.store.clone(),
+        encoder: Encoder::new(v.min_y, palette.0.names().to_vec()),
+        compression: server.compression_threshold(),
+    });
+}
+
+fn dig(
+    clients: Query<&GameMode>,
+    mut layers: Query<&mut ChunkLayer>,
+    mut events: EventReader<DiggingEvent>,
+    mut edited: ResMut<Edited>,
+) {
+    let Ok(mut layer) = layers.get_single_mut() else { return };
+    for event in events.iter() {
+        let Ok(mode) = clients.get(event.client) else { continue };
+        let done = match *mode {
+            GameMode::Creative => event.state == DiggingState::Start,
+            GameMode::Survival => event.state == DiggingState::Stop,
+            GameMode::Adventure | GameMode::Spectator => false,
+        };
+        let Some(block) = layer.block(event.position) else { continue };
+        if !done || block.state.is_air() || block.state == BlockState::BEDROCK && *mode != GameMode::Creative {
+            continue;
+        }
+        layer.set_block(event.position, BlockState::AIR);
+        edited.0.insert(ChunkPos::from_block_pos(event.position));
+    }
+}
+
+fn place(
+    mut clients: Query<(&mut Inventory, &GameMode, &HeldItem)>,
+    mut layers: Query<&mut ChunkLayer>,
+    mut events: EventReader<InteractBlockEvent>,
+    mut edited: ResMut<Edited>,
+) {
+    let Ok(mut layer) = layers.get_single_mut() else { return };
+    for event in events.iter() {
+        if event.hand != Hand::Main {
+            continue;
+        }
+        let Ok((mut inventory, mode, held)) = clients.get_mut(event.client) else { continue };
+        if matches!(*mode, GameMode::Adventure | GameMode::Spectator) {
+            continue;
+        }
+        let slot = held.slot();
+        let Some(stack) = inventory.slot(slot).cloned() else { continue };
+        let Some(kind) = BlockKind::from_item_kind(stack.item) else { continue };
+        let replaceable = |pos: BlockPos| layer.block(pos).is_some_and(|b| b.state.is_replaceable());
+        // A click on grass or water puts the block there, as vanilla does; otherwise against
+        // the face clicked, where there must be room.
+        let at = if replaceable(event.position) { event.position } else { event.position.get_in_direction(event.face) };
+        if !replaceable(at) {
+            continue;
+        }
+        if *mode == GameMode::Survival {
+            match stack.count().saturating_sub(1) {
+                0 => inventory.set_slot(slot, None),
+                left => inventory.set_slot_amount(slot, left),
+            }
+        }
+        layer.set_block(at, kind.to_state());
+        edited.0.insert(ChunkPos::from_block_pos(at));
+    }
+}
+
+/// Relights and saves every chunk edited this tick.
+fn save_edited(
+    layers: Query<&ChunkLayer>,
+    mut edited: ResMut<Edited>,
+    saver: Option<ResMut<Saver>>,
+    streamer: Option<ResMut<Streamer>>,
+    mut sent: Query<&mut super::stream::LightSent>,
+) {
+    if edited.0.is_empty() {
+        return;
+    }
+    let (Ok(layer), Some(mut saver), Some(mut streamer)) = (layers.get_single(), saver, streamer) else { return };
+    for pos in edited.0.drain() {
+        let Some(loaded) = layer.chunk(pos) else { continue };
+        let chunk = snapshot(loaded);
+        let light = SkyLight::of(&chunk);
+        let mut encoder = PacketEncoder::new();
+        encoder.set_compression(saver.compression);
+        match encoder.append_packet(&light.packet(pos)) {
+            Ok(()) => {
+                streamer.relight(pos, Arc::from(&encoder.take()[..]));
+                for mut s in &mut sent {
+                    s.forget(pos);
+                }
+            }
+            Err(e) => tracing::error!("light of edited chunk {}, {}: {e}", pos.x, pos.z),
+        }
+        if let Some(store) = saver.store.clone() {
+            let nbt = saver.encoder.encode(pos.x, pos.z, &chunk, &light);
+            if let Err(e) = store.save(pos.x, pos.z, &nbt) {
+                tracing::error!("saving edited chunk {}, {}: {e}", pos.x, pos.z);
+                say!("could not save the edit to chunk {}, {}: {e}", pos.x, pos.z);
+            }
+        }
+    }
+}
+
+/// A copy of a loaded chunk's blocks and biomes, to light and encode.
+fn snapshot(chunk: &impl Chunk) -> UnloadedChunk {
+    let height = chunk.height();
+    let mut out = UnloadedChunk::with_height(height);
+    for y in 0..height {
+        for z in 0..16 {
+            for x in 0..16 {
+                let b = chunk.block_state(x, y, z);
+                if !b.is_air() {
+                    out.set_block_state(x, y, z, b);
+                }
+            }
+        }
+    }
+    for y in 0..height / 4 {
+        for z in 0..4 {
+            for x in 0..4 {
+                out.set_biome(x, y, z, chunk.biome(x, y, z));
+            }
+        }
+    }
+    out
+}
