@@ -118,13 +118,13 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
 /// world with the shipped biome rules) outside the shallow sea, recorded before the sea fix.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0xd751_78c2_b0a8_d779;
+const OUTSIDE_SHALLOWS_HASH: u64 = 0x773e_0ab9_4010_f9b0;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], recorded after the sea fix.
-const PROCEDURAL_HASH: u64 = 0x06c9_9c6d_ffc2_41f0;
+const PROCEDURAL_HASH: u64 = 0x28da_8b80_1892_e690;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]
-const LEARNED_HASH: u64 = 0x6bd1_c878_c836_8417;
+const LEARNED_HASH: u64 = 0x6a85_4fbc_5629_0b6c;
 
 fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();

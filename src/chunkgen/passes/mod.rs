@@ -6,7 +6,9 @@
 //! rock). Each must be a pure function of global coordinates so that chunks meet without
 //! seams whatever order they are built in.
 
+mod caves;
 mod columns;
+mod ores;
 mod rock;
 mod surface;
 mod vegetation;
@@ -25,15 +27,18 @@ pub struct Pass {
 }
 
 /// Every pass, in order.
-pub const PASSES: [Pass; 5] = [
+pub const PASSES: [Pass; 7] = [
     // The pipeline's columns around the chunk and the biome of every 4×4×4 cell.
     Pass { name: "columns", run: columns::run },
     // Bedrock, then deepslate and stone up to every column's ground.
     Pass { name: "rock", run: rock::run },
     // The sea: water from the sea floor to the water top, ice on top where cold.
     Pass { name: "water", run: water::run },
-    // Carvers (caves, ravines) go here: after the rock and sea exist, before the surface is
-    // laid on what is left. Then ores, into the rock the carvers left.
+    // Caverns and tunnels (lava deep down), kept dry under and beside the sea: after the
+    // rock and sea exist, before the surface is laid on what is left.
+    Pass { name: "caves", run: caves::run },
+    // Ore veins and rock blobs, vanilla's placements, into the stone and deepslate left.
+    Pass { name: "ores", run: ores::run },
     // The ground's top and filler blocks, by biome, steepness and water depth.
     Pass { name: "surface", run: surface::run },
     // Trees, then plants where every block they need is still air.

@@ -1,0 +1,272 @@
+//! The ores pass: veins of ore and blobs of other rock in the stone and deepslate the caves
+//! left, with vanilla 1.20.1's placements (attempts per chunk, vein size, height range and
+//! shape), from its data-driven world generation (`worldgen/placed_feature/ore_*.json`, as
+//! listed on the Minecraft Wiki's "Ore" page): coal, iron, copper, gold, redstone, lapis,
+//! diamond, emerald in the mountains; granite, diorite, andesite, tuff, gravel and dirt blobs.
+//!
+//! A vein belongs to the chunk it starts in; chunks draw the veins of their eight neighbours
+//! too and keep the blocks that fall inside themselves, so veins cross chunk borders whole
+//! whatever order chunks are built in. A vein replaces only stone or deepslate (its deepslate
+//! variant in deepslate), never air, water, lava or the ground's own blocks.
+
+use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+
+use crate::chunkgen::hash::hash3;
+use crate::chunkgen::{ChunkContext, CHUNK};
+
+/// How a placement spreads its heights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Height {
+    /// Uniform between the two Y (inclusive).
+    Uniform(i32, i32),
+    /// Triangular between the two Y, densest in the middle (vanilla's "trapezoid" with no
+    /// plateau); parts outside the world are simply never drawn.
+    Triangle(i32, i32),
+}
+
+/// One of vanilla's ore placements.
+#[derive(Clone, Copy, Debug)]
+pub struct Ore {
+    /// The block in stone.
+    pub stone: BlockState,
+    /// The block in deepslate.
+    pub deepslate: BlockState,
+    /// Attempts per chunk (vanilla's `count`); fractions are a chance of one more.
+    pub per_chunk: f32,
+    /// Blocks a vein tries to place (vanilla's `size`).
+    pub size: u32,
+    /// Where its attempts start.
+    pub height: Height,
+    /// Only under ground at least this many metres high (emerald: mountains).
+    pub min_elevation_m: f32,
+}
+
+const fn ore(stone: BlockState, deepslate: BlockState, per_chunk: f32, size: u32, height: Height) -> Ore {
+    Ore { stone, deepslate, per_chunk, size, height, min_elevation_m: f32::NEG_INFINITY }
+}
+
+const fn rock(block: BlockState, per_chunk: f32, size: u32, height: Height) -> Ore {
+    ore(block, block, per_chunk, size, height)
+}
+
+/// Vanilla 1.20.1's overworld ore and blob placements (Minecraft Wiki, "Ore" and "Blob").
+pub const ORES: [Ore; 22] = {
+    use BlockState as B;
+    use Height::{Triangle as T, Uniform as U};
+    [
+        ore(B::COAL_ORE, B::DEEPSLATE_COAL_ORE, 30.0, 17, U(136, 320)),
+        ore(B::COAL_ORE, B::DEEPSLATE_COAL_ORE, 20.0, 17, T(0, 192)),
+        ore(B::IRON_ORE, B::DEEPSLATE_IRON_ORE, 90.0, 9, T(80, 384)),
+        ore(B::IRON_ORE, B::DEEPSLATE_IRON_ORE, 10.0, 9, T(-24, 56)),
+        ore(B::IRON_ORE, B::DEEPSLATE_IRON_ORE, 10.0, 4, U(-64, 72)),
+        ore(B::COPPER_ORE, B::DEEPSLATE_COPPER_ORE, 16.0, 10, T(-16, 112)),
+        ore(B::GOLD_ORE, B::DEEPSLATE_GOLD_ORE, 4.0, 9, T(-64, 32)),
+        ore(B::GOLD_ORE, B::DEEPSLATE_GOLD_ORE, 0.5, 9, U(-64, -48)),
+        ore(B::REDSTONE_ORE, B::DEEPSLATE_REDSTONE_ORE, 4.0, 8, U(-64, 15)),
+        ore(B::REDSTONE_ORE, B::DEEPSLATE_REDSTONE_ORE, 8.0, 8, T(-96, -32)),
+        ore(B::LAPIS_ORE, B::DEEPSLATE_LAPIS_ORE, 2.0, 7, T(-32, 32)),
+        ore(B::LAPIS_ORE, B::DEEPSLATE_LAPIS_ORE, 4.0, 7, U(-64, 64)),
+        ore(B::DIAMOND_ORE, B::DEEPSLATE_DIAMOND_ORE, 7.0, 4, T(-144, 16)),
+        ore(B::DIAMOND_ORE, B::DEEPSLATE_DIAMOND_ORE, 1.0 / 9.0, 12, T(-144, 16)),
+        Ore { min_elevation_m: 1000.0, ..ore(B::EMERALD_ORE, B::DEEPSLATE_EMERALD_ORE, 100.0, 3, T(-16, 480)) },
+        rock(B::GRANITE, 2.0, 64, U(0, 60)),
+        rock(B::DIORITE, 2.0, 64, U(0, 60)),
+        rock(B::ANDESITE, 2.0, 64, U(0, 60)),
+        rock(B::TUFF, 2.0, 64, U(-64, 0)),
+        rock(B::GRAVEL, 14.0, 33, U(-64, 320)),
+        rock(B::DIRT, 7.0, 33, U(0, 160)),
+        rock(B::GRANITE, 1.0 / 6.0, 64, U(64, 128)),
+    ]
+};
+
+/// Squared radius (blocks²) of the ball a vein of `size` blocks fills: (4/3)·π·R³ = size.
+fn radius2(size: u32) -> f32 {
+    (3.0 * size as f32 / (4.0 * std::f32::consts::PI)).powf(2.0 / 3.0)
+}
+
+/// How far (blocks) a vein of `size` blocks reaches from its start, jitter included.
+fn reach(size: u32) -> i64 {
+    (radius2(size) + JITTER).sqrt().ceil() as i64
+}
+
+/// Up to this much (blocks²) is added to a block's squared distance from a vein's start, so
+/// veins are lumpy rather than balls.
+const JITTER: f32 = 1.5;
+
+/// Writes every vein that starts in this chunk or a neighbour into this chunk.
+pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+    let v = *ctx.vertical();
+    let (seed, columns) = (ctx.seed(), ctx.columns());
+    let (cx, cz) = (ctx.x0.div_euclid(CHUNK), ctx.z0.div_euclid(CHUNK));
+    for (k, ore) in ORES.iter().enumerate() {
+        let r = reach(ore.size);
+        for nz in cz - 1..=cz + 1 {
+            for nx in cx - 1..=cx + 1 {
+                for (x, y, z) in starts(seed, k as u64, (nx, nz), ore) {
+                    // Veins too far from this chunk to touch it are skipped whole.
+                    let (lx, lz) = (x - ctx.x0, z - ctx.z0);
+                    if lx < -r || lx >= CHUNK + r || lz < -r || lz >= CHUNK + r {
+                        continue;
+                    }
+                    if y < v.min_y + 1 || y >= v.min_y + v.height {
+                        continue;
+                    }
+                    if ore.min_elevation_m > f32::NEG_INFINITY && columns.elevation(x, z) < ore.min_elevation_m {
+                        continue;
+                    }
+                    place_vein(
+                        chunk,
+                        ctx.x0,
+                        ctx.z0,
+                        v.min_y,
+                        ore,
+                        hash3(seed, 0x0E1A ^ k as u64, x, i64::from(y), z),
+                        (x, y, z),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Where the veins of `ore` that start in chunk (`cx`, `cz`) start (global block coordinates).
+pub fn starts(seed: u64, kind: u64, (cx, cz): (i64, i64), ore: &Ore) -> Vec<(i64, i32, i64)> {
+    let h = |i: u64, what: u64| hash3(seed, 0x0DE5 ^ (kind << 16) ^ (what << 8), cx, i as i64, cz);
+    let unit = |x: u64| (x >> 40) as f32 / (1u64 << 24) as f32;
+    let whole = ore.per_chunk.floor() as u64;
+    let extra = unit(h(u64::MAX, 0)) < ore.per_chunk.fract();
+    (0..whole + u64::from(extra))
+        .map(|i| {
+            let r = h(i, 1);
+            let x = cx * CHUNK + (r & 15) as i64;
+            let z = cz * CHUNK + ((r >> 4) & 15) as i64;
+            let y = match ore.height {
+                Height::Uniform(lo, hi) => lo + ((r >> 8) % (hi - lo + 1) as u64) as i32,
+                Height::Triangle(lo, hi) => {
+                    // The sum of two uniforms is triangular.
+                    let half = (hi - lo) as u64 / 2 + 1;
+                    lo + ((r >> 8) % half) as i32 + ((r >> 24) % half) as i32
+                }
+            };
+            (x, y, z)
+        })
+        .collect()
+}
+
+/// One vein of about `ore.size` blocks: the blocks within the vein's ball of its start, each
+/// block's distance jittered so veins are lumpy, written where they fall inside the chunk.
+fn place_vein(
+    chunk: &mut UnloadedChunk,
+    x0: i64,
+    z0: i64,
+    min_y: i32,
+    ore: &Ore,
+    salt: u64,
+    (sx, sy, sz): (i64, i32, i64),
+) {
+    let (r, r2) = (reach(ore.size), radius2(ore.size));
+    for dy in -r..=r {
+        let ly = i64::from(sy) + dy - i64::from(min_y);
+        if ly < 1 || ly >= i64::from(chunk.height()) {
+            continue;
+        }
+        for dz in -r..=r {
+            let lz = sz + dz - z0;
+            if !(0..CHUNK).contains(&lz) {
+                continue;
+            }
+            for dx in -r..=r {
+                let lx = sx + dx - x0;
+                if !(0..CHUNK).contains(&lx) {
+                    continue;
+                }
+                let jitter = (hash3(salt, 0, dx, dy, dz) >> 40) as f32 / (1u64 << 24) as f32 * JITTER;
+                if (dx * dx + dy * dy + dz * dz) as f32 + jitter > r2 + JITTER * 0.5 {
+                    continue;
+                }
+                let (lx, ly, lz) = (lx as u32, ly as u32, lz as u32);
+                let block = match chunk.block_state(lx, ly, lz) {
+                    BlockState::STONE => ore.stone,
+                    BlockState::DEEPSLATE => ore.deepslate,
+                    _ => continue,
+                };
+                chunk.set_block_state(lx, ly, lz, block);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing;
+    use super::*;
+    use crate::terrain::Rect;
+
+    /// Chunk (`cx`, `cz`) of solid rock up to 2,000 m (Y 143), with this pass run.
+    fn ores_in(cx: i32, cz: i32) -> UnloadedChunk {
+        let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome("minecraft:plains"));
+        let v = *g.vertical();
+        let mut ctx = ChunkContext::new(&g, &rules, &palette, cx, cz);
+        let (x0, z0) = (ctx.x0, ctx.z0);
+        ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 4, x0 - 4, 24, 24), |_, _| (2000.0, 10.0)));
+        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        super::super::rock::run(&mut ctx, &mut chunk);
+        run(&mut ctx, &mut chunk);
+        chunk
+    }
+
+    #[test]
+    fn veins_start_where_vanilla_places_them() {
+        for (k, ore) in ORES.iter().enumerate() {
+            let (lo, hi) = match ore.height {
+                Height::Uniform(lo, hi) | Height::Triangle(lo, hi) => (lo, hi),
+            };
+            let mut n = 0;
+            for c in 0..200 {
+                for (x, y, z) in starts(5, k as u64, (c, -c), ore) {
+                    n += 1;
+                    assert!((lo..=hi).contains(&y), "ore {k} at Y {y}");
+                    assert!((c * 16..c * 16 + 16).contains(&x) && (-c * 16..-c * 16 + 16).contains(&z));
+                }
+            }
+            let want = 200.0 * ore.per_chunk;
+            assert!((n as f32 - want).abs() <= 3.0 * want.sqrt() + 1.0, "ore {k}: {n} starts for {want}");
+        }
+    }
+
+    #[test]
+    fn ores_sit_at_their_depths_in_their_host_rock_and_veins_cross_chunk_borders() {
+        let v = *testing::generator().vertical();
+        let chunks: Vec<UnloadedChunk> = (0..4).map(|cx| ores_in(cx, 2)).collect();
+        let at = |x: i64, y: i32, z: u32| {
+            let c = &chunks[x.div_euclid(16) as usize];
+            c.block_state(x.rem_euclid(16) as u32, (y - v.min_y) as u32, z)
+        };
+        let (mut diamonds, mut coal, mut crossing) = (0, 0, 0);
+        for x in 0..64i64 {
+            for z in 0..16u32 {
+                for y in v.min_y..144 {
+                    let b = at(x, y, z);
+                    if b == BlockState::DIAMOND_ORE || b == BlockState::DEEPSLATE_DIAMOND_ORE {
+                        diamonds += 1;
+                        assert!(y <= 16 + 3, "diamond at Y {y}");
+                    }
+                    if b == BlockState::COAL_ORE || b == BlockState::DEEPSLATE_COAL_ORE {
+                        coal += 1;
+                    }
+                    // Deepslate variants only in deepslate (below Y 0), plain ones above.
+                    let name = b.to_kind().to_str();
+                    if name.ends_with("_ore") {
+                        assert_eq!(name.starts_with("deepslate_"), y < 0, "{name} at Y {y}");
+                        // The same ore on both sides of a chunk border: a vein drawn whole.
+                        if x % 16 == 15 && x < 63 && at(x + 1, y, z) == b {
+                            crossing += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(diamonds > 0 && coal > 100, "{diamonds} diamond and {coal} coal blocks in four chunks");
+        assert!(crossing > 0, "no vein crosses a chunk border");
+    }
+}
