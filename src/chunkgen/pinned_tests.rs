@@ -118,13 +118,13 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
 /// world with the shipped biome rules) outside the shallow sea, recorded before the sea fix.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0x773e_0ab9_4010_f9b0;
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xdc55_00ea_4dba_dfd1;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], recorded after the sea fix.
-const PROCEDURAL_HASH: u64 = 0x28da_8b80_1892_e690;
+const PROCEDURAL_HASH: u64 = 0xdfad_7d6d_2a2d_5139;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]
-const LEARNED_HASH: u64 = 0x6a85_4fbc_5629_0b6c;
+const LEARNED_HASH: u64 = 0x81ec_37ff_e8fe_d6a9;
 
 fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();

@@ -2,7 +2,7 @@
 //! rock, as vanilla 1.18+ does with density noise, and floods what it carves at Y −55 and
 //! below with lava (vanilla's lava level).
 //!
-//! The cave field is a density sampled on a lattice of 4 × 4 × 4 blocks and interpolated
+//! The cave field is a density sampled on a lattice of 4 × 8 × 4 blocks and interpolated
 //! trilinearly between (vanilla samples its noise the same way): caverns where a two-octave
 //! noise is high, tunnels where two independent noises are both near their middle (the
 //! intersection of two surfaces is a line). A pure function of (seed, x, y, z), so caves run
@@ -18,8 +18,11 @@ use valence::prelude::{BlockState, Chunk, UnloadedChunk};
 use crate::chunkgen::hash::value_noise3;
 use crate::chunkgen::{ChunkContext, CHUNK};
 
-/// Lattice spacing of the cave density, blocks.
+/// Lattice spacing of the cave density across, blocks.
 const LATTICE: i64 = 4;
+/// Lattice spacing of the cave density up and down, blocks (vanilla's noise cells are
+/// 4 × 8 × 4 too; caves are flatter than they are wide).
+const LATTICE_Y: i64 = 8;
 /// Blocks of rock kept between a cave and the ground of a sea column, or of any column within
 /// [`SHORE_REACH`] blocks of one.
 pub const SEA_SEAL: i32 = 8;
@@ -80,7 +83,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     }
     // The lattice over the chunk, from the lattice row at or below `bottom` to the one at or
     // above `top`.
-    let (ly0, ly1) = ((bottom as i64).div_euclid(LATTICE), (top as i64).div_euclid(LATTICE) + 1);
+    let (ly0, ly1) = ((bottom as i64).div_euclid(LATTICE_Y), (top as i64).div_euclid(LATTICE_Y) + 1);
     let n = (CHUNK / LATTICE + 1) as usize;
     let rows = (ly1 - ly0 + 1) as usize;
     let seed = ctx.seed();
@@ -89,7 +92,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
         for k in 0..n {
             for i in 0..n {
                 let (x, z) = (ctx.x0 + i as i64 * LATTICE, ctx.z0 + k as i64 * LATTICE);
-                lattice[(j * n + k) * n + i] = density(seed, x, ly * LATTICE, z);
+                lattice[(j * n + k) * n + i] = density(seed, x, ly * LATTICE_Y, z);
             }
         }
     }
@@ -130,13 +133,13 @@ fn carve_cell(
     min_y: i32,
 ) {
     let l = LATTICE as usize;
-    let y0 = ((ly0 + j as i64) * LATTICE) as i32;
-    for dy in 0..l {
+    let y0 = ((ly0 + j as i64) * LATTICE_Y) as i32;
+    for dy in 0..LATTICE_Y as usize {
         let y = y0 + dy as i32;
         if y < bottom {
             continue;
         }
-        let ty = dy as f32 / LATTICE as f32;
+        let ty = dy as f32 / LATTICE_Y as f32;
         for dz in 0..l {
             let tz = dz as f32 / LATTICE as f32;
             for dx in 0..l {
@@ -245,12 +248,14 @@ mod tests {
         let g = testing::generator();
         let seed = g.seed;
         let interpolated = |x: i64, y: i64, z: i64| {
-            let (cx, cy, cz) = (x.div_euclid(LATTICE), y.div_euclid(LATTICE), z.div_euclid(LATTICE));
+            let (cx, cy, cz) = (x.div_euclid(LATTICE), y.div_euclid(LATTICE_Y), z.div_euclid(LATTICE));
             let t = |v: i64| v.rem_euclid(LATTICE) as f32 / LATTICE as f32;
-            let d = |i: i64, j: i64, k: i64| density(seed, (cx + i) * LATTICE, (cy + j) * LATTICE, (cz + k) * LATTICE);
+            let ty = y.rem_euclid(LATTICE_Y) as f32 / LATTICE_Y as f32;
+            let d =
+                |i: i64, j: i64, k: i64| density(seed, (cx + i) * LATTICE, (cy + j) * LATTICE_Y, (cz + k) * LATTICE);
             let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
             let plane = |j: i64| lerp(lerp(d(0, j, 0), d(1, j, 0), t(x)), lerp(d(0, j, 1), d(1, j, 1), t(x)), t(z));
-            lerp(plane(0), plane(1), t(y))
+            lerp(plane(0), plane(1), ty)
         };
         let mut carved_blocks = 0;
         for cx in [-1, 0] {

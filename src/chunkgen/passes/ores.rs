@@ -180,7 +180,10 @@ fn place_vein(
                 if !(0..CHUNK).contains(&lx) {
                     continue;
                 }
-                let jitter = (hash3(salt, 0, dx, dy, dz) >> 40) as f32 / (1u64 << 24) as f32 * JITTER;
+                // One multiply per block (not a full hash): plenty for lumpiness.
+                let cell = ((dx + 16) | (dy + 16) << 5 | (dz + 16) << 10) as u64;
+                let h = (salt ^ cell).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                let jitter = (h >> 40) as f32 / (1u64 << 24) as f32 * JITTER;
                 if (dx * dx + dy * dy + dz * dz) as f32 + jitter > r2 + JITTER * 0.5 {
                     continue;
                 }

@@ -110,11 +110,18 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     let mut encoder = Encoder::new(generator.vertical().min_y, palette.names().to_vec());
     let plan = Plan::new(Task { center_x: 7_000_000, center_z: 0, radius: 160, shape: Shape::Square }, Shard::ALL);
     let (mut fill, mut light, mut encode, mut compress) = (0.0, 0.0, 0.0, 0.0);
+    let mut passes: Vec<(&'static str, f64)> = Vec::new();
     for n in 0..plan.total() {
         let (x, z) = plan.chunk(n);
         let t = Instant::now();
-        let chunk = generator.chunk(&rules, &palette, x, z);
+        let (chunk, timings) = generator.chunk_timed(&rules, &palette, x, z);
         fill += t.elapsed().as_secs_f64();
+        for (i, timing) in timings.iter().enumerate() {
+            if passes.len() <= i {
+                passes.push((timing.name, 0.0));
+            }
+            passes[i].1 += timing.nanos as f64 * 1e-9;
+        }
         let t = Instant::now();
         let sky = SkyLight::of(&chunk);
         light += t.elapsed().as_secs_f64();
@@ -127,6 +134,9 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     }
     let per = |s: f64| vec![1e3 * s / plan.total() as f64];
     out.push(Measurement::new("per chunk, 1 thread: terrain + blocks + biomes (fill)", "ms", per(fill)));
+    for (name, seconds) in passes {
+        out.push(Measurement::new(&format!("  of which the {name} pass"), "ms", per(seconds)));
+    }
     out.push(Measurement::new("per chunk, 1 thread: sky light", "ms", per(light)));
     out.push(Measurement::new("per chunk, 1 thread: NBT encoding", "ms", per(encode)));
     out.push(Measurement::new("per chunk, 1 thread: zlib compression", "ms", per(compress)));
