@@ -217,3 +217,43 @@ fn shards_write_disjoint_region_files_that_together_equal_the_whole_task() {
     run_to_end(pregen(&config, &whole, 300));
     assert!(saved_chunks(&sharded) == saved_chunks(&whole), "the shards' union differs from the whole task");
 }
+
+#[test]
+fn amulet_finds_ores_at_vanilla_depths_dry_caves_and_lava_deep_down() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let config_path = write_config(dir.path(), 1);
+    let world = dir.path().join("world");
+    // Inland foothills of the default world (140 km east, 48 km north of the origin).
+    let (x, z) = (140_000 / 40, -48_000 / 40);
+    run_to_end(common::pregen::command(&config_path, &world, (x, z), 64));
+    let (cx, cz) = ((x / 16) as i32, (z / 16) as i32);
+    let c = amulet::census(&world, (cx - 3, cz - 3), (cx + 2, cz + 2));
+    println!("census: {c}");
+    let ores = &c["ores"];
+    // Vanilla 1.20.1's ranges (Minecraft Wiki, "Ore"), a vein's reach (4 blocks) around them.
+    for (ore, lo, hi) in [
+        ("coal", 0, 320),
+        ("iron", -64, 384),
+        ("copper", -16, 112),
+        ("gold", -64, 32),
+        ("redstone", -64, 15),
+        ("lapis", -64, 64),
+        ("diamond", -64, 16),
+    ] {
+        let (plain, deep) = (&ores[format!("{ore}_ore")], &ores[format!("deepslate_{ore}_ore")]);
+        let blocks = plain["blocks"].as_i64().unwrap_or(0) + deep["blocks"].as_i64().unwrap_or(0);
+        assert!(blocks > 0, "no {ore} in 36 chunks: {ores}");
+        for v in [plain, deep].into_iter().filter(|v| !v.is_null()) {
+            let (min, max) = (v["min_y"].as_i64().expect("min_y"), v["max_y"].as_i64().expect("max_y"));
+            assert!(min >= lo - 4 && max <= hi + 4, "{ore} at Y {min}..{max}, vanilla {lo}..{hi}");
+        }
+        // Deepslate variants in the deepslate, below Y 0; plain ones above.
+        assert!(deep.is_null() || deep["max_y"].as_i64() < Some(0), "{deep}");
+        assert!(plain.is_null() || plain["min_y"].as_i64() >= Some(0), "{plain}");
+    }
+    let (below, air) = (c["below_ground"].as_i64().expect("below"), c["cave_air"].as_i64().expect("air"));
+    assert!(air * 100 > below && air * 5 < below, "cave air {air} of {below} blocks under the ground");
+    assert!(c["lava"].as_i64() > Some(0), "no lava deep down");
+    assert!(c["land_columns_away_from_sea"].as_i64() > Some(1000), "{c}");
+    assert_eq!(c["water_below_ground_away_from_sea"], 0, "water under dry land: {c}");
+}

@@ -59,3 +59,17 @@ pub fn block_name(state: BlockState) -> String {
     }
     name
 }
+
+/// Amulet's census of chunks `from..=to` (chunk x, z) of the world saved in `world`
+/// (`tests/anvil/census.py`): ore blocks by kind with their heights, cave air, lava and water
+/// under the ground.
+pub fn census(world: &Path, from: (i32, i32), to: (i32, i32)) -> Value {
+    let out = Command::new(python())
+        .arg(repo().join("tests/anvil/census.py"))
+        .arg(world)
+        .args([from.0, from.1, to.0, to.1].map(|v| v.to_string()))
+        .output()
+        .expect("run the Amulet census");
+    assert!(out.status.success(), "Amulet census failed: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("JSON from the Amulet census")
+}
