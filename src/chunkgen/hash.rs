@@ -39,6 +39,23 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Smooth value noise in `[0, 1)` over 3-D space, in lattice units (a feature per unit):
+/// trilinear between hashed lattice points, smoothstepped. For caves, sampled on a coarse
+/// lattice and interpolated between.
+pub fn value_noise3(seed: u64, salt: u64, x: f64, y: f64, z: f64) -> f32 {
+    let (ix, iy, iz) = (x.floor(), y.floor(), z.floor());
+    let (fx, fy, fz) = (smooth((x - ix) as f32), smooth((y - iy) as f32), smooth((z - iz) as f32));
+    let (ix, iy, iz) = (ix as i64, iy as i64, iz as i64);
+    let at = |dx: i64, dy: i64, dz: i64| unit3(seed, salt, ix + dx, iy + dy, iz + dz);
+    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    let plane = |dy: i64| {
+        let near = lerp(at(0, dy, 0), at(1, dy, 0), fx);
+        let far = lerp(at(0, dy, 1), at(1, dy, 1), fx);
+        lerp(near, far, fz)
+    };
+    lerp(plane(0), plane(1), fy)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -71,21 +88,4 @@ mod tests {
             assert!((0.0..1.0).contains(&a));
         }
     }
-}
-
-/// Smooth value noise in `[0, 1)` over 3-D space, in lattice units (a feature per unit):
-/// trilinear between hashed lattice points, smoothstepped. For caves, sampled on a coarse
-/// lattice and interpolated between.
-pub fn value_noise3(seed: u64, salt: u64, x: f64, y: f64, z: f64) -> f32 {
-    let (ix, iy, iz) = (x.floor(), y.floor(), z.floor());
-    let (fx, fy, fz) = (smooth((x - ix) as f32), smooth((y - iy) as f32), smooth((z - iz) as f32));
-    let (ix, iy, iz) = (ix as i64, iy as i64, iz as i64);
-    let at = |dx: i64, dy: i64, dz: i64| unit3(seed, salt, ix + dx, iy + dy, iz + dz);
-    let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-    let plane = |dy: i64| {
-        let near = lerp(at(0, dy, 0), at(1, dy, 0), fx);
-        let far = lerp(at(0, dy, 1), at(1, dy, 1), fx);
-        lerp(near, far, fz)
-    };
-    lerp(plane(0), plane(1), fy)
 }

@@ -79,6 +79,7 @@ pub const REFERENCE_SLOPE: f64 = 0.1;
 pub const SLOPE_POWER: f64 = 0.75;
 
 /// Amplitude (metres) of an octave of wavelength `lambda` over relief of slope `slope`.
+#[cfg(test)]
 fn amplitude(lambda: f64, slope: f64) -> f64 {
     AMPLITUDE * steepness(slope) * octave_scale(lambda)
 }
