@@ -36,7 +36,7 @@ pub fn conditions(
 ) -> Conditions {
     let surface_m = columns.elevation(x, z);
     let surface_temperature = columns.get(channel::TEMPERATURE, x, z);
-    let ground_top = columns.surface_y(x, z).max(vertical.water_top_y());
+    let ground_top = columns.water_top_y(x, z).unwrap_or(columns.surface_y(x, z));
     let (elevation_m, temperature_c) = if centre_y <= ground_top {
         (surface_m, surface_temperature)
     } else {

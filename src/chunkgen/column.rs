@@ -43,7 +43,7 @@ impl Generator {
         let v = &self.vertical;
         let candidate = |x: i64, z: i64| -> Option<(i32, Plant)> {
             let ground_y = columns.surface_y(x, z);
-            if ground_y < v.water_top_y() || columns.drop_blocks(x, z) >= surface::STEEP_DROP_BLOCKS {
+            if columns.is_wet(x, z) || columns.drop_blocks(x, z) >= surface::STEEP_DROP_BLOCKS {
                 return None;
             }
             let biome = self.surface_biome(rules, columns, x, z);
@@ -91,7 +91,7 @@ impl Generator {
             }
             let ground_y = columns.surface_y(x, z);
             let ground = self.ground_at(columns, biome, x, z);
-            let dry = ground_y >= v.water_top_y() && !ground.top.is_liquid();
+            let dry = !columns.is_wet(x, z) && !ground.top.is_liquid();
             if dry && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top) {
                 let tree = Tree::new(self.seed, x, z, ground_y, kind);
                 if tree.top_y() < v.min_y + v.height {
@@ -153,10 +153,9 @@ impl Generator {
     /// The ground of column (`x`, `z`) in `biome` (top and filler, by water depth, steepness
     /// and temperature).
     pub(super) fn ground_at(&self, columns: &Columns, biome: &str, x: i64, z: i64) -> Ground {
-        let surface_y = columns.surface_y(x, z);
         surface::ground(&Site {
             biome,
-            water_depth: (self.vertical.water_top_y() - surface_y).max(0),
+            water_depth: columns.water_depth(x, z),
             drop_blocks: columns.drop_blocks(x, z),
             temperature_c: columns.get(channel::TEMPERATURE, x, z),
             seed: self.seed,

@@ -143,6 +143,8 @@ pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), 
         let rules = rules.load().map_err(Failure::input)?;
         let generator = Generator::new(std::sync::Arc::new(pipeline(config, &models)?), config);
         render::render_biomes(&generator, &rules, &req, &mut |d, t| progress.update(d, t))
+    } else if a.layer == Layer::Water {
+        render::render_water(&pipeline(config, &models)?, &req, &mut |d, t| progress.update(d, t))
     } else {
         render::render(&pipeline(config, &models)?, &req, &mut |d, t| progress.update(d, t))
     }

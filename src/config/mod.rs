@@ -176,6 +176,7 @@ impl Config {
     pub fn terrain(&self) -> TerrainSettings {
         TerrainSettings {
             metres_per_block: self.world.metres_per_block,
+            vertical_metres_per_block: self.world.vertical_metres_per_block,
             layout: self.layout.clone(),
             climate: self.climate.clone(),
             engine: self.engine.clone(),

@@ -23,17 +23,21 @@ pub enum Layer {
     Variability,
     /// Minecraft biomes, from the biome rules (see [`render_biomes`](super::render_biomes)).
     Biome,
+    /// Rivers by discharge, lakes, dry lake beds and the sea (see
+    /// [`render_water`](super::render_water)).
+    Water,
 }
 
 impl Layer {
     /// Every layer, in the order the help text lists them.
-    pub const ALL: [Layer; 6] = [
+    pub const ALL: [Layer; 7] = [
         Layer::Elevation,
         Layer::Temperature,
         Layer::Precipitation,
         Layer::Seasonality,
         Layer::Variability,
         Layer::Biome,
+        Layer::Water,
     ];
 
     /// The name used on the command line and in titles.
@@ -45,6 +49,7 @@ impl Layer {
             Layer::Seasonality => "seasonality",
             Layer::Variability => "variability",
             Layer::Biome => "biome",
+            Layer::Water => "water",
         }
     }
 }
@@ -57,7 +62,7 @@ impl fmt::Display for Layer {
 
 /// A layer name that is not one of [`Layer::ALL`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown layer `{given}` (allowed: elevation, temperature, precipitation, seasonality, variability, biome)")]
+#[error("unknown layer `{given}` (allowed: elevation, temperature, precipitation, seasonality, variability, biome, water)")]
 pub struct UnknownLayer {
     /// The name as given.
     pub given: String,
@@ -109,7 +114,8 @@ fn fraction(range: (f32, f32), v: f32) -> f32 {
     (v - range.0) / (range.1 - range.0)
 }
 
-/// The style of a layer, or `None` for the biome layer (not drawable yet).
+/// The style of a layer, or `None` for the biome and water layers (drawn by their own
+/// renderers).
 pub(crate) fn style(layer: Layer) -> Option<Style> {
     use ramp::{SEASONALITY_RANGE as S, TEMPERATURE_RANGE as T, VARIABILITY_RANGE as V};
     let climate = |channel: usize, legend: Legend| Style {
@@ -173,7 +179,7 @@ pub(crate) fn style(layer: Layer) -> Option<Style> {
                 ticks: &[0.0, 20.0, 40.0, 60.0, 80.0],
             },
         ),
-        Layer::Biome => return None,
+        Layer::Biome | Layer::Water => return None,
     })
 }
 
@@ -215,9 +221,9 @@ mod tests {
     }
 
     #[test]
-    fn only_the_biome_layer_lacks_a_style() {
+    fn only_the_biome_and_water_layers_lack_a_style() {
         for l in Layer::ALL {
-            assert_eq!(style(l).is_none(), l == Layer::Biome, "{l}");
+            assert_eq!(style(l).is_none(), matches!(l, Layer::Biome | Layer::Water), "{l}");
         }
     }
 }

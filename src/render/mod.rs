@@ -7,6 +7,7 @@
 
 mod biomes;
 mod layer;
+mod water;
 mod oblique;
 pub(crate) mod panel;
 pub(crate) mod ramp;
@@ -19,6 +20,7 @@ use image::{Rgb, RgbImage};
 
 pub use biomes::render_biomes;
 pub use layer::{Layer, UnknownLayer};
+pub use water::render_water;
 pub use oblique::{render_oblique, ObliqueRequest, MAX_OBLIQUE_SIDE};
 
 use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL};

@@ -7,6 +7,7 @@
 pub mod climate;
 pub mod encoding;
 pub mod erosion;
+pub mod hydrology;
 pub mod infinite;
 pub mod layout;
 pub mod metrics;

@@ -202,6 +202,9 @@ pub struct TerrainSettings {
     /// Horizontal size of one block column, metres: the world's scale. The pipeline's finest
     /// grid is always 4 blocks, whatever the scale.
     pub metres_per_block: f64,
+    /// Metres of elevation per block above the sea (`world.vertical_metres_per_block`): a
+    /// river's channel is cut whole blocks deep.
+    pub vertical_metres_per_block: f64,
     /// The procedural continental layout.
     pub layout: LayoutSettings,
     /// The climate model.
@@ -214,6 +217,7 @@ impl Default for TerrainSettings {
     fn default() -> Self {
         TerrainSettings {
             metres_per_block: DEFAULT_METRES_PER_BLOCK,
+            vertical_metres_per_block: 25.0,
             layout: LayoutSettings::default(),
             climate: ClimateSettings::default(),
             engine: EngineSettings::default(),

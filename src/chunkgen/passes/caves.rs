@@ -56,13 +56,12 @@ pub fn density(seed: u64, x: i64, y: i64, z: i64) -> f32 {
 pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     let v = *ctx.vertical();
     let columns = ctx.columns();
-    let water_top = v.water_top_y();
     // The highest Y each column may be carved to.
     let ceiling: Vec<i32> = ctx
         .each_column()
         .map(|(_, _, x, z)| {
             let near_sea = (-SHORE_REACH..=SHORE_REACH)
-                .any(|dz| (-SHORE_REACH..=SHORE_REACH).any(|dx| columns.surface_y(x + dx, z + dz) < water_top));
+                .any(|dz| (-SHORE_REACH..=SHORE_REACH).any(|dx| columns.is_wet(x + dx, z + dz)));
             let ground = columns.surface_y(x, z);
             if near_sea {
                 let lowest = (-SHORE_REACH..=SHORE_REACH)

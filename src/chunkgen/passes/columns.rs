@@ -37,7 +37,7 @@ fn biomes<'r>(ctx: &ChunkContext<'r>, columns: &Columns) -> Vec<&'r str> {
     for cz in 0..4 {
         for cx in 0..4 {
             let (sx, sz) = cells::sample_column(ctx.x0 / CELL + cx, ctx.z0 / CELL + cz);
-            let ground_top = columns.surface_y(sx, sz).max(v.water_top_y());
+            let ground_top = columns.water_top_y(sx, sz).unwrap_or(columns.surface_y(sx, sz));
             // Every cell at or below the ground shares one set of conditions.
             let ground = ctx.rules.biome(&cells::conditions(columns, v, lapse, sx, sz, ground_top));
             for cy in 0..cells_y {

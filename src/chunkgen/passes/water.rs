@@ -1,28 +1,43 @@
-//! The water pass: the sea, from above each sea column's ground to the water top, frozen on
-//! top where the column is colder than the sea-ice threshold.
+//! The water pass: the sea, rivers and lakes, from above each wet column's ground to its
+//! water top (frozen on top where the column is colder than the ice threshold), and falling
+//! water where a river steps down from one column to the next.
 
 use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{PropName, PropValue};
 
 use crate::chunkgen::surface::SEA_ICE_C;
 use crate::chunkgen::ChunkContext;
 use crate::terrain::pipeline::channel;
 
-/// Fills every column whose ground is below the water top with water up to it (ice on top
-/// where cold).
+/// Water falling from a higher neighbour (vanilla's `water[level=8]`): what a static world
+/// shows where a river steps down a block.
+pub fn falling_water() -> BlockState {
+    BlockState::WATER.set(PropName::Level, PropValue::_8)
+}
+
+/// Fills every wet column with water from its ground up to its water top (ice on top where
+/// cold), and the side of each step down with falling water.
 pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     let v = *ctx.vertical();
     let columns = ctx.columns();
-    let water_top = v.water_top_y();
     for (lx, lz, x, z) in ctx.each_column() {
-        let surface_y = columns.surface_y(x, z);
-        if surface_y >= water_top {
-            continue;
-        }
-        for y in surface_y + 1..=water_top {
+        let Some(top) = columns.water_top_y(x, z) else { continue };
+        let ground = columns.surface_y(x, z);
+        for y in ground + 1..=top {
             chunk.set_block_state(lx, (y - v.min_y) as u32, lz, BlockState::WATER);
         }
-        if columns.get(channel::TEMPERATURE, x, z) < SEA_ICE_C {
-            chunk.set_block_state(lx, (water_top - v.min_y) as u32, lz, BlockState::ICE);
+        let frozen = columns.get(channel::TEMPERATURE, x, z) < SEA_ICE_C;
+        // A neighbour's water standing higher pours over into this column.
+        let above = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+            .iter()
+            .filter_map(|&(dx, dz)| columns.water_top_y(x + dx, z + dz))
+            .max()
+            .unwrap_or(top);
+        for y in top + 1..=above {
+            chunk.set_block_state(lx, (y - v.min_y) as u32, lz, falling_water());
+        }
+        if frozen && above == top {
+            chunk.set_block_state(lx, (top - v.min_y) as u32, lz, BlockState::ICE);
         }
     }
 }

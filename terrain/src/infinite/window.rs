@@ -41,10 +41,12 @@ impl Axis {
     }
 
     /// Separable tent weights for one window: 1 at the centre, [`EDGE_WEIGHT`] at both ends.
+    /// Windows that do not overlap (stride = size) weigh 1 everywhere: each cell has one
+    /// window, and its value passes through bit for bit.
     pub fn tent(&self) -> Vec<f32> {
         let n = self.size as usize;
-        if n == 1 {
-            return vec![1.0];
+        if n == 1 || self.stride >= self.size {
+            return vec![1.0; n];
         }
         let c = (n - 1) as f64 / 2.0;
         (0..n)

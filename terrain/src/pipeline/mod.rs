@@ -9,6 +9,7 @@
 //! blocks themselves.
 
 mod finest;
+mod network_inputs;
 
 pub use crate::stages;
 
@@ -19,6 +20,7 @@ pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
+use crate::hydrology::{Basins, Rivers, WaterColumns};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
@@ -27,6 +29,7 @@ pub use crate::settings::BLOCKS_PER_MODEL_PIXEL;
 use crate::settings::{StageName, TerrainSettings};
 use crate::tile::{Rect, Tile};
 use finest::Finest;
+use network_inputs::NetworkInputs;
 
 /// The finest grid a stage is trained on, metres: the layout's and the `detail` stage's
 /// (the learned windows' seams are measured on it).
@@ -52,11 +55,29 @@ pub mod channel {
     /// erosion filter (what the learned grid resolves, ~1 km), the same at any world scale;
     /// biome rules use it, so gullies do not speckle biomes.
     pub const RELIEF_SLOPE: usize = 5;
+    /// Water surface of a river or lake over the column, metres (NaN where there is none;
+    /// the sea is everything below 0 m). Block columns only (NaN on the model grid).
+    pub const WATER_LEVEL: usize = 6;
+    /// What water the column holds: 0 none, 2 lake, 3 dry lake bed (its level is the
+    /// basin's spill level), 4 river ([`crate::hydrology::Kind`] codes and
+    /// [`crate::hydrology::WaterColumns::RIVER`]).
+    pub const WATER: usize = 7;
+    /// Discharge of the river or lake, m³/s (0 elsewhere).
+    pub const DISCHARGE: usize = 8;
     /// Number of channels.
-    pub const COUNT: usize = 6;
+    pub const COUNT: usize = 9;
     /// Channel names, in order, for files and legends.
-    pub const NAMES: [&str; COUNT] =
-        ["elevation_m", "temperature_c", "seasonality_c", "precipitation_mm", "variability_pct", "relief_slope_deg"];
+    pub const NAMES: [&str; COUNT] = [
+        "elevation_m",
+        "temperature_c",
+        "seasonality_c",
+        "precipitation_mm",
+        "variability_pct",
+        "relief_slope_deg",
+        "water_level_m",
+        "water",
+        "discharge_m3s",
+    ];
 }
 
 /// Why a pipeline could not be built.
@@ -128,6 +149,8 @@ pub struct Pipeline {
     coarse_elevation: Arc<dyn Source>,
     coarse_sketch: Arc<dyn Source>,
     precipitation: Arc<Windowed>,
+    network: Arc<Windowed>,
+    rivers: Rivers,
 }
 
 impl Pipeline {
@@ -186,6 +209,23 @@ impl Pipeline {
         // did), resampled to it, with the erosion filter's octaves the grid can hold.
         let base = ran.pop().unwrap_or_else(|| StageGrid::layout(Arc::new(layout.elevation(BASE_METRES)), BASE_METRES));
         let erosion = ErosionFilter::new(seed);
+        let inputs = |base: Arc<dyn Source>, base_metres: f64| NetworkInputs {
+            base,
+            base_metres,
+            erosion,
+            sketch: coarse_sketch.clone(),
+            precipitation: precipitation.clone(),
+            temperature_offset_c: settings.climate.temperature_offset_c as f32,
+            lapse_c_per_km: settings.climate.lapse_rate_c_per_km as f32,
+        };
+        let network = Windowed::new(
+            &engine,
+            Basins {
+                fine: Arc::new(inputs(base.source.clone(), base.metres)),
+                coarse: Arc::new(inputs(coarse_elevation.clone(), coarse_metres)),
+            },
+        );
+        let rivers = Rivers::new(network.clone(), seed);
         let finest = Finest::new(base.source, base.metres, settings.model_pixel_metres(), erosion);
         Ok(Pipeline {
             seed,
@@ -197,6 +237,8 @@ impl Pipeline {
             coarse_elevation,
             coarse_sketch,
             precipitation,
+            network,
+            rivers,
         })
     }
 
@@ -279,6 +321,7 @@ impl Pipeline {
         for (d, &s) in out.channel_mut(channel::RELIEF_SLOPE).iter_mut().zip(finest.channel(finest::SLOPE)) {
             *d = s.atan().to_degrees();
         }
+        out.channel_mut(channel::WATER_LEVEL).fill(f32::NAN);
         (out, finest.select(&[finest::SLOPE]))
     }
 
@@ -297,8 +340,26 @@ impl Pipeline {
     /// Elevation alone (metres, one channel) for every block column of `blocks`.
     pub fn elevation_columns(&self, blocks: Rect) -> Tile {
         let finest = self.finest.query(Pipeline::model_rect(&blocks));
-        let (elevation, _) = self.carve_blocks(&finest, blocks);
+        let (mut elevation, _) = self.carve_blocks(&finest, blocks);
+        self.water_columns(blocks, &mut elevation);
         Tile::from_data(1, blocks, elevation)
+    }
+
+    /// The rivers, lakes and dry lake beds of `blocks`, their channels and valleys cut into
+    /// `elevation` (metres, row-major over `blocks`).
+    fn water_columns(&self, blocks: Rect, elevation: &mut [f32]) -> WaterColumns {
+        self.rivers.columns(blocks, self.block_metres(), self.settings.vertical_metres_per_block, elevation)
+    }
+
+    /// The courses of the rivers near `blocks`, for maps.
+    pub fn river_courses(&self, blocks: Rect) -> Vec<crate::hydrology::Course> {
+        self.rivers.courses(blocks, self.block_metres())
+    }
+
+    /// The drainage network over `cells` (cells of [`crate::hydrology::CELL_METRES`]), with
+    /// the [`crate::hydrology::grid`] channels: maps, statistics and tests read it.
+    pub fn network(&self, cells: Rect) -> Tile {
+        self.network.query(cells)
     }
 
     /// All channels for every block column of `blocks` (y = z, x = x in block coordinates):
@@ -308,7 +369,8 @@ impl Pipeline {
     pub fn columns(&self, blocks: Rect) -> Tile {
         let (model, slope) = self.model_and_slope(Pipeline::model_rect(&blocks));
         let finest = Tile::stack(&[&model.select(&[channel::ELEVATION]), &slope]);
-        let (elevation, smooth) = self.carve_blocks(&finest, blocks);
+        let (mut elevation, smooth) = self.carve_blocks(&finest, blocks);
+        let water = self.water_columns(blocks, &mut elevation);
         let mut out = resample::bilinear(&model, BLOCK_RATIO, blocks);
         let lapse = self.settings.climate.lapse_rate_c_per_km as f32;
         let n = blocks.area();
@@ -317,6 +379,11 @@ impl Pipeline {
             // The climate model's lapse rate over the height the detail adds (nothing at sea).
             out.data[channel::TEMPERATURE * n + i] -= lapse * (e.max(0.0) - b.max(0.0)) / 1000.0;
         }
+        out.channel_mut(channel::WATER_LEVEL).copy_from_slice(&water.level);
+        for (d, &k) in out.channel_mut(channel::WATER).iter_mut().zip(&water.kind) {
+            *d = f32::from(k);
+        }
+        out.channel_mut(channel::DISCHARGE).copy_from_slice(&water.discharge);
         out
     }
 

@@ -1,0 +1,336 @@
+//! Rivers and lakes at the block grid: courses drawn through the network's cells, channels
+//! and valleys cut into the relief, lake and river water levels per block column.
+
+use std::sync::Arc;
+
+use super::drainage::{Kind, D8, NO_DOWN};
+use super::{grid, CELL_METRES};
+use crate::infinite::Source;
+use crate::noise::hash3;
+use crate::tile::{Rect, Tile};
+
+/// Discharge (m³/s) from which a cell's water is a river a player sees: a stream of a few
+/// hundred km² in a temperate climate (HydroRIVERS, the global river map, starts at
+/// 0.1 m³/s or 10 km²).
+pub const RIVER_DISCHARGE: f32 = 0.5;
+/// Rivers are drawn this many times wider than hydraulic geometry says (a 10 m stream would
+/// be a quarter of a block): wide enough to see and to swim in, still ordered by size.
+const WIDTH_EXAGGERATION: f64 = 3.0;
+/// The narrowest river, blocks.
+const MIN_WIDTH_BLOCKS: f64 = 2.0;
+/// The widest river, metres.
+const MAX_WIDTH_M: f64 = 1200.0;
+/// How far a node strays from its cell's centre, in cells (either axis): courses are not
+/// drawn on a lattice.
+const JITTER: f64 = 0.3;
+/// Straight pieces each course curve is drawn with.
+const SEGMENTS: usize = 8;
+/// Slope of a valley's sides above the floodplain (m/m): the valley a river cuts widens as
+/// it deepens into higher ground.
+const VALLEY_SLOPE: f64 = 0.2;
+/// How far beyond its floodplain a river's valley reaches, metres; past it the relief is
+/// untouched.
+const VALLEY_REACH_M: f64 = 640.0;
+/// How far around a lake cell (in cells) its water may spread into lower ground.
+const LAKE_REACH: f64 = 0.5;
+/// Channel depth at a river's centre, blocks, for the smallest river; one more per ×10
+/// discharge, at most [`MAX_DEPTH_BLOCKS`].
+const MAX_DEPTH_BLOCKS: f64 = 4.0;
+
+/// Width (metres) of a river of discharge `q` (m³/s) on blocks of `block_m` metres: the
+/// hydraulic-geometry width 4·√Q, exaggerated ([`WIDTH_EXAGGERATION`]), never narrower than
+/// [`MIN_WIDTH_BLOCKS`] blocks.
+pub fn water_width_m(q: f64, block_m: f64) -> f64 {
+    (WIDTH_EXAGGERATION * 4.0 * q.max(0.0).sqrt()).min(MAX_WIDTH_M).max(MIN_WIDTH_BLOCKS * block_m)
+}
+
+/// What [`Rivers::columns`] says of each block column, row-major over the rectangle.
+pub struct WaterColumns {
+    /// Water surface, metres (river or lake); NaN where neither (the sea is the caller's:
+    /// everything below 0 m).
+    pub level: Vec<f32>,
+    /// [`Kind`] code of the water: [`Kind::Land`] for none, [`Kind::Sea`] is never given here,
+    /// river water is [`WaterColumns::RIVER`].
+    pub kind: Vec<u8>,
+    /// Discharge of the river or lake, m³/s (0 elsewhere).
+    pub discharge: Vec<f32>,
+}
+
+impl WaterColumns {
+    /// Code of river water in [`WaterColumns::kind`] (beside [`Kind`]'s codes).
+    pub const RIVER: u8 = 4;
+}
+
+/// A stretch of a river's course as a map draws it.
+pub struct Course {
+    /// Points along it, metres (x east, z south).
+    pub points: Vec<(f64, f64)>,
+    /// Its discharge, m³/s (the largest along it).
+    pub discharge: f64,
+}
+
+/// One curve of a river's course: points (x, z metres), discharge and water level along it.
+struct Piece {
+    points: Vec<[f64; 4]>,
+    lo: (f64, f64),
+    hi: (f64, f64),
+    reach: f64,
+}
+
+impl Piece {
+    /// A quadratic Bézier from `a` via `b` to `c` (each x, z, discharge, level): discharge
+    /// linear along it, the level a Bézier too (so it never rises where the three levels fall).
+    fn new(a: [f64; 4], b: [f64; 4], c: [f64; 4], block_m: f64) -> Piece {
+        let points: Vec<[f64; 4]> = (0..=SEGMENTS)
+            .map(|k| {
+                let t = k as f64 / SEGMENTS as f64;
+                let (u, v, w) = ((1.0 - t) * (1.0 - t), 2.0 * t * (1.0 - t), t * t);
+                [
+                    u * a[0] + v * b[0] + w * c[0],
+                    u * a[1] + v * b[1] + w * c[1],
+                    a[2] + t * (c[2] - a[2]),
+                    u * a[3] + v * b[3] + w * c[3],
+                ]
+            })
+            .collect();
+        let q = a[2].max(c[2]);
+        let reach = water_width_m(q, block_m) + VALLEY_REACH_M;
+        let lo = points.iter().fold((f64::INFINITY, f64::INFINITY), |m, p| (m.0.min(p[0]), m.1.min(p[1])));
+        let hi = points.iter().fold((f64::NEG_INFINITY, f64::NEG_INFINITY), |m, p| (m.0.max(p[0]), m.1.max(p[1])));
+        Piece { points, lo, hi, reach }
+    }
+
+    /// Distance (metres) from (`x`, `z`) to the curve, and the discharge and level there.
+    fn nearest(&self, x: f64, z: f64) -> (f64, f64, f64) {
+        let mut best = (f64::INFINITY, 0.0, 0.0);
+        for s in self.points.windows(2) {
+            let (p, q) = (s[0], s[1]);
+            let (dx, dz) = (q[0] - p[0], q[1] - p[1]);
+            let len2 = dx * dx + dz * dz;
+            let t = if len2 > 0.0 { (((x - p[0]) * dx + (z - p[1]) * dz) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            let d = (x - p[0] - t * dx).hypot(z - p[1] - t * dz);
+            if d < best.0 {
+                best = (d, p[2] + t * (q[2] - p[2]), p[3] + t * (q[3] - p[3]));
+            }
+        }
+        best
+    }
+
+    /// True when the curve's valley may reach the box [`lo`, `hi`] (metres).
+    fn touches(&self, lo: (f64, f64), hi: (f64, f64)) -> bool {
+        self.lo.0 - self.reach <= hi.0
+            && self.hi.0 + self.reach >= lo.0
+            && self.lo.1 - self.reach <= hi.1
+            && self.hi.1 + self.reach >= lo.1
+    }
+}
+
+/// Rivers and lakes of one world at the block grid.
+pub struct Rivers {
+    network: Arc<dyn Source>,
+    seed: u64,
+}
+
+/// The network's cells around a rectangle, with the questions the block grid asks of them.
+struct Cells {
+    tile: Tile,
+}
+
+impl Cells {
+    fn kind(&self, cy: i64, cx: i64) -> Kind {
+        Kind::from_code(self.tile.get(grid::KIND, cy, cx))
+    }
+
+    fn discharge(&self, cy: i64, cx: i64) -> f64 {
+        f64::from(self.tile.get(grid::DISCHARGE, cy, cx))
+    }
+
+    fn level(&self, cy: i64, cx: i64) -> f64 {
+        f64::from(self.tile.get(grid::LEVEL, cy, cx))
+    }
+
+    /// The downstream neighbour, if any.
+    fn down(&self, cy: i64, cx: i64) -> Option<(i64, i64)> {
+        let code = self.tile.get(grid::DOWN, cy, cx).round() as i8;
+        (code != NO_DOWN).then(|| {
+            let (dy, dx) = D8[code as usize];
+            (cy + dy, cx + dx)
+        })
+    }
+
+    /// True for a river cell: land whose discharge reaches [`RIVER_DISCHARGE`] and that
+    /// drains somewhere.
+    fn is_river(&self, cy: i64, cx: i64) -> bool {
+        self.kind(cy, cx) == Kind::Land
+            && self.tile.get(grid::DISCHARGE, cy, cx) >= RIVER_DISCHARGE
+            && self.down(cy, cx).is_some()
+    }
+}
+
+impl Rivers {
+    /// The rivers of world seed `seed` over `network` (a [`super::Basins`] tensor).
+    pub fn new(network: Arc<dyn Source>, seed: u64) -> Rivers {
+        Rivers { network, seed: seed ^ 0x0052_1BE5_0000_0001 }
+    }
+
+    /// Where the course of cell (`cy`, `cx`) passes, metres (x, z): its centre, jittered.
+    fn node(&self, cy: i64, cx: i64) -> (f64, f64) {
+        let h = hash3(self.seed, cy, cx);
+        let u = |bits: u64| ((bits & 0xFFFF) as f64 / 65535.0 - 0.5) * 2.0 * JITTER;
+        ((cx as f64 + 0.5 + u(h)) * CELL_METRES, (cy as f64 + 0.5 + u(h >> 16)) * CELL_METRES)
+    }
+
+    /// The network's cells (kind, discharge, level, downstream) over `cells`.
+    pub fn network(&self, cells: Rect) -> Tile {
+        self.network.query(cells)
+    }
+
+    /// The course curves of every river cell of `nodes` (which, grown by one cell, `cells`
+    /// must cover).
+    fn pieces(&self, cells: &Cells, nodes: Rect, block_m: f64) -> Vec<Piece> {
+        let mut out = Vec::new();
+        for cy in nodes.y0..nodes.y1() {
+            for cx in nodes.x0..nodes.x1() {
+                if !cells.is_river(cy, cx) {
+                    continue;
+                }
+                let Some((dy, dx)) = cells.down(cy, cx) else { continue };
+                let here = cells.level(cy, cx);
+                let there = cells.level(dy, dx).min(here);
+                let (pc, pd) = (self.node(cy, cx), self.node(dy, dx));
+                let q = cells.discharge(cy, cx);
+                let mid = |a: (f64, f64), b: (f64, f64)| ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
+                let m = mid(pc, pd);
+                let end = [m.0, m.1, q, (here + there) / 2.0];
+                let centre = [pc.0, pc.1, q, here];
+                let mut upstream = 0;
+                for &(oy, ox) in &D8 {
+                    let (uy, ux) = (cy + oy, cx + ox);
+                    let feeds = (cells.is_river(uy, ux) || cells.kind(uy, ux) == Kind::Lake)
+                        && cells.down(uy, ux) == Some((cy, cx));
+                    if !feeds {
+                        continue;
+                    }
+                    upstream += 1;
+                    let pu = self.node(uy, ux);
+                    let s = mid(pu, pc);
+                    let level = (cells.level(uy, ux).max(here) + here) / 2.0;
+                    out.push(Piece::new([s.0, s.1, cells.discharge(uy, ux), level], centre, end, block_m));
+                }
+                if upstream == 0 {
+                    // A source: the course starts at the node.
+                    out.push(Piece::new(centre, [(pc.0 + m.0) / 2.0, (pc.1 + m.1) / 2.0, q, (here + end[3]) / 2.0], end, block_m));
+                }
+                if matches!(cells.kind(dy, dx), Kind::Sea | Kind::Lake | Kind::Dry) {
+                    // The mouth: on into the sea, the lake or the dry basin's bed.
+                    let last = [pd.0, pd.1, q, there];
+                    out.push(Piece::new(end, [(m.0 + pd.0) / 2.0, (m.1 + pd.1) / 2.0, q, (end[3] + there) / 2.0], last, block_m));
+                }
+            }
+        }
+        out
+    }
+
+    /// The course of every river near `blocks` (blocks of `block_m` metres): its curves as
+    /// polylines in metres (x, z), each with its discharge (m³/s) — what a map draws.
+    pub fn courses(&self, blocks: Rect, block_m: f64) -> Vec<Course> {
+        let (lo, hi, nodes) = self.around(blocks, block_m);
+        let cells = Cells { tile: self.network(nodes.pad(1)) };
+        self.pieces(&cells, nodes, block_m)
+            .into_iter()
+            .filter(|p| p.touches(lo, hi))
+            .map(|p| Course {
+                discharge: p.points.iter().map(|q| q[2]).fold(0.0, f64::max),
+                points: p.points.iter().map(|q| (q[0], q[1])).collect(),
+            })
+            .collect()
+    }
+
+    /// The box (metres) `blocks` covers and the network nodes whose courses may reach it.
+    fn around(&self, blocks: Rect, block_m: f64) -> ((f64, f64), (f64, f64), Rect) {
+        let lo = (blocks.x0 as f64 * block_m, blocks.y0 as f64 * block_m);
+        let hi = (blocks.x1() as f64 * block_m, blocks.y1() as f64 * block_m);
+        let reach = MAX_WIDTH_M + VALLEY_REACH_M + CELL_METRES * (1.0 + JITTER);
+        let cell = |m: f64| (m / CELL_METRES).floor() as i64;
+        let (y0, x0) = (cell(lo.1 - reach), cell(lo.0 - reach));
+        (lo, hi, Rect::new(y0, x0, cell(hi.1 + reach) - y0 + 1, cell(hi.0 + reach) - x0 + 1))
+    }
+
+    /// The water of every block column of `blocks` (blocks of `block_m` metres, `vertical_m`
+    /// metres of height per block), cutting river channels and valleys into `elevation`
+    /// (metres, row-major over `blocks`).
+    pub fn columns(&self, blocks: Rect, block_m: f64, vertical_m: f64, elevation: &mut [f32]) -> WaterColumns {
+        let n = blocks.area();
+        let (lo, hi, nodes) = self.around(blocks, block_m);
+        let cell = |m: f64| (m / CELL_METRES).floor() as i64;
+        let cells = Cells { tile: self.network(nodes.pad(1)) };
+        let pieces: Vec<Piece> =
+            self.pieces(&cells, nodes, block_m).into_iter().filter(|p| p.touches(lo, hi)).collect();
+
+        let mut out = WaterColumns { level: vec![f32::NAN; n], kind: vec![Kind::Land as u8; n], discharge: vec![0.0; n] };
+        let mut i = 0;
+        for z in blocks.y0..blocks.y1() {
+            for x in blocks.x0..blocks.x1() {
+                let (xm, zm) = ((x as f64 + 0.5) * block_m, (z as f64 + 0.5) * block_m);
+                let mut e = f64::from(elevation[i]);
+                let mut river: Option<(f64, f64, f64)> = None;
+                for p in &pieces {
+                    let (d, q, level) = p.nearest(xm, zm);
+                    if d >= p.reach {
+                        continue;
+                    }
+                    let half = water_width_m(q, block_m) / 2.0;
+                    let plain = 2.0 * half;
+                    let floor = level + VALLEY_SLOPE * (d - plain).max(0.0);
+                    let weight = if d <= plain { 1.0 } else { smoothstep(1.0 - (d - plain) / (p.reach - plain)) };
+                    e = e.min(f64::from(elevation[i]) - weight * (f64::from(elevation[i]) - floor).max(0.0));
+                    if d <= half && river.is_none_or(|r| d / half < r.0) {
+                        river = Some((d / half, q, level));
+                    }
+                }
+                if let Some((across, q, level)) = river {
+                    let full = (1.0 + (q / f64::from(RIVER_DISCHARGE)).log10()).clamp(1.0, MAX_DEPTH_BLOCKS).floor();
+                    let depth = (full * (1.0 - across * across).sqrt()).round().max(1.0);
+                    e = e.min(level - depth * vertical_m - 0.01);
+                    out.level[i] = level as f32;
+                    out.kind[i] = WaterColumns::RIVER;
+                    out.discharge[i] = q as f32;
+                }
+                // Lakes and dry beds: lower ground near a lake cell, under its level.
+                let (cy, cx) = (cell(zm), cell(xm));
+                let mut lake: Option<(f64, f64, f64)> = None;
+                for (oy, ox) in (-1..=1).flat_map(|a| (-1..=1).map(move |b| (a, b))) {
+                    let (ly, lx) = (cy + oy, cx + ox);
+                    if cells.kind(ly, lx) != Kind::Lake {
+                        continue;
+                    }
+                    let gap = |p: f64, c: i64| {
+                        let (a, b) = (c as f64 * CELL_METRES, (c + 1) as f64 * CELL_METRES);
+                        (a - p).max(p - b).max(0.0)
+                    };
+                    let d = gap(xm, lx).hypot(gap(zm, ly));
+                    if d <= LAKE_REACH * CELL_METRES && lake.is_none_or(|l| d < l.0) {
+                        lake = Some((d, cells.level(ly, lx), cells.discharge(ly, lx)));
+                    }
+                }
+                if let Some((_, level, q)) = lake.filter(|l| e < l.1) {
+                    out.level[i] = level as f32;
+                    out.kind[i] = Kind::Lake as u8;
+                    out.discharge[i] = q as f32;
+                } else if river.is_none() && cells.kind(cy, cx) == Kind::Dry && e < cells.level(cy, cx) {
+                    out.level[i] = cells.level(cy, cx) as f32;
+                    out.kind[i] = Kind::Dry as u8;
+                }
+                elevation[i] = e as f32;
+                i += 1;
+            }
+        }
+        out
+    }
+}
+
+/// 0 at 0, 1 at 1, flat at both ends.
+fn smoothstep(t: f64) -> f64 {
+    let t = t.clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}

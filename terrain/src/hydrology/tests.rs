@@ -1,0 +1,84 @@
+//! The network over a real pipeline: rivers reach an end, levels never rise downstream,
+//! answers do not depend on the query.
+
+use super::drainage::{Kind, D8, NO_DOWN};
+use super::*;
+use crate::{Pipeline, TerrainSettings};
+
+fn pipeline() -> Pipeline {
+    Pipeline::new(5, &TerrainSettings::default())
+}
+
+/// The cell a cell drains to.
+fn downstream(t: &Tile, y: i64, x: i64) -> Option<(i64, i64)> {
+    let code = t.get(grid::DOWN, y, x).round() as i8;
+    (code != NO_DOWN).then(|| {
+        let (dy, dx) = D8[code as usize];
+        (y + dy, x + dx)
+    })
+}
+
+#[test]
+fn every_river_runs_downhill_across_tiles_into_the_sea_a_lake_or_a_dry_basin() {
+    let p = pipeline();
+    // Three by three tiles, and one more tile of room for paths to run on.
+    let inner = Rect::new(-TILE, -TILE, 3 * TILE, 3 * TILE);
+    let all = inner.pad(2 * TILE);
+    let t = p.network(all);
+    let (mut rivers, mut ends) = (0, [0usize; 4]);
+    let tile_of = |c: (i64, i64)| (c.0.div_euclid(TILE), c.1.div_euclid(TILE));
+    // River links that cross from one tile into another, and those whose discharge drops
+    // there (each tile sums what its own window holds).
+    let mut links = std::collections::BTreeSet::new();
+    let mut drops = std::collections::BTreeSet::new();
+    for y in inner.y0..inner.y1() {
+        for x in inner.x0..inner.x1() {
+            let is_river = Kind::from_code(t.get(grid::KIND, y, x)) == Kind::Land
+                && t.get(grid::DISCHARGE, y, x) >= RIVER_DISCHARGE;
+            if !is_river {
+                continue;
+            }
+            rivers += 1;
+            let (mut c, mut steps) = ((y, x), 0);
+            loop {
+                let Some(d) = downstream(&t, c.0, c.1) else {
+                    panic!("river cell ({y}, {x}) ends on land at {c:?}");
+                };
+                assert!(all.contains_rect(&Rect::new(d.0, d.1, 1, 1)), "river from ({y}, {x}) leaves the test area");
+                let (here, there) = (t.get(grid::LEVEL, c.0, c.1), t.get(grid::LEVEL, d.0, d.1));
+                assert!(there <= here + 0.01, "level rises from {c:?} ({here}) to {d:?} ({there})");
+                let kind = Kind::from_code(t.get(grid::KIND, d.0, d.1));
+                if kind != Kind::Land {
+                    ends[kind as usize] += 1;
+                    break;
+                }
+                let (qc, qd) = (t.get(grid::DISCHARGE, c.0, c.1), t.get(grid::DISCHARGE, d.0, d.1));
+                if tile_of(c) != tile_of(d) {
+                    links.insert((c, d));
+                    if qd < qc * 0.999 {
+                        drops.insert((c, d));
+                    }
+                } else {
+                    assert!(qd >= qc, "discharge falls inside a tile from {c:?} ({qc}) to {d:?} ({qd})");
+                }
+                c = d;
+                steps += 1;
+                assert!(steps < 10_000, "loop from ({y}, {x})");
+            }
+        }
+    }
+    assert!(rivers > 50, "only {rivers} river cells");
+    assert!(drops.len() * 5 <= links.len(), "{} of {} links between tiles lose water", drops.len(), links.len());
+    assert!(ends[Kind::Sea as usize] > 0, "{ends:?}");
+}
+
+#[test]
+fn the_network_is_the_same_whatever_the_query() {
+    let p = pipeline();
+    let whole = p.network(Rect::new(-40, -40, 80, 80));
+    let q = Pipeline::new(5, &TerrainSettings::default());
+    for r in [Rect::new(-40, -40, 7, 80), Rect::new(10, 3, 30, 37), Rect::new(-1, -1, 2, 2)] {
+        let part = q.network(r);
+        assert_eq!(part.data, whole.crop(r).data, "{r:?}");
+    }
+}
