@@ -153,6 +153,41 @@ fn a_player_spawns_on_land_and_sees_the_terrain_the_pipeline_describes() {
 }
 
 #[test]
+fn a_player_by_a_river_sees_its_water_and_the_river_biome() {
+    let biomes = fixtures::shipped_biomes();
+    let rules = fixtures::rules(&biomes);
+    // The first seed whose spawn has a river within 40 blocks (rivers follow the terrain, so
+    // the test looks for one rather than naming a place).
+    let (seed, generator, river) = (1..=40u64)
+        .find_map(|seed| {
+            let generator = generator(&fixtures::seeded_config(seed));
+            let spawn = find_spawn(&generator, &rules);
+            let river =
+                fixtures::river_columns_near(&generator, (i64::from(spawn.block.x), i64::from(spawn.block.z)), 40);
+            (river.len() >= 8).then_some((seed, generator, river))
+        })
+        .expect("no seed of 1..=40 has a river within 40 blocks of its spawn");
+    // Every fourth river column, at most 24.
+    let sample: Vec<(i64, i64, i32)> = river.iter().step_by((river.len() / 24).max(1)).copied().take(24).collect();
+    let list: String = sample.iter().map(|(x, z, _)| format!("{x},{z};")).collect();
+    let mut server = Server::start(&biomes, seed);
+    let report = server.probe("wader", &["--columns".into(), list]);
+    let columns = report["columns"].as_array().unwrap_or_else(|| panic!("no columns: {report}"));
+    assert_eq!(columns.len(), sample.len(), "{report}");
+    for (column, &(x, z, top)) in columns.iter().zip(&sample) {
+        assert_eq!((column["x"].as_i64(), column["z"].as_i64()), (Some(x), Some(z)), "{column}");
+        let block = column["block"].as_str().unwrap_or("");
+        assert!(block == "water" || block == "ice", "({x}, {z}) river column shows {block}: {column}");
+        assert_eq!(column["y"].as_i64(), Some(i64::from(top)), "({x}, {z}) water top: {column}");
+        let biome = column["biome"].as_str().unwrap_or("");
+        assert!(biome == "river" || biome == "frozen_river", "({x}, {z}) biome {biome}: {column}");
+    }
+    println!("seed {seed}: {} river columns by the spawn, {} checked", river.len(), sample.len());
+    drop(generator);
+    assert!(server.stop().success());
+}
+
+#[test]
 fn garbage_and_wrong_versions_are_refused_and_players_still_join() {
     let mut server = Server::start(&fixtures::shipped_biomes(), 2);
     let report = server.node("garbage.js", &[]);

@@ -26,6 +26,7 @@ fn ground(temperature_c: f32, precipitation_mm: f32, surface_m: f32, slope_deg: 
         elevation_m: surface_m,
         surface_m,
         slope_deg,
+        water: if surface_m < 0.0 { WaterBody::Sea } else { WaterBody::None },
     }
 }
 
@@ -78,6 +79,8 @@ const REQUIRED: &[&str] = &[
     "jagged_peaks",
     "frozen_peaks",
     "stony_peaks",
+    "river",
+    "frozen_river",
 ];
 
 #[test]
@@ -105,6 +108,16 @@ fn the_shipped_rules_cover_every_realistic_cell_and_reach_every_required_biome()
                         cells += 1;
                     }
                 }
+            }
+        }
+    }
+    // Inland water, through the climates.
+    for water in WaterBody::ALL {
+        for t in -30..=32 {
+            for p in [100.0, 800.0, 2500.0] {
+                let c = Conditions { water, ..ground(t as f32, p, 200.0, 2.0) };
+                assert!(rules.matching_rule(&c).is_some(), "no rule for {c:?}");
+                reached.insert(rules.biome(&c));
             }
         }
     }
@@ -151,6 +164,16 @@ fn coasts_and_seas_follow_height_slope_depth_and_temperature() {
     // The water column above a sea floor keeps the ocean biome.
     let water = Conditions { elevation_m: -100.0, ..ground(12.0, 900.0, -4000.0, 0.5) };
     assert_eq!(rules.biome(&water), "minecraft:deep_ocean");
+}
+
+#[test]
+fn rivers_are_river_biomes_frozen_where_cold_and_lakes_keep_the_land_biome() {
+    let rules = shipped();
+    let at = |t: f32, surface_m: f32, water| rules.biome(&Conditions { water, ..ground(t, 900.0, surface_m, 2.0) });
+    assert_eq!(at(12.0, 200.0, WaterBody::River), "minecraft:river");
+    assert_eq!(at(12.0, 1500.0, WaterBody::River), "minecraft:river", "mountain rivers too");
+    assert_eq!(at(-5.0, 200.0, WaterBody::River), "minecraft:frozen_river");
+    assert_eq!(at(12.0, 200.0, WaterBody::Lake), at(12.0, 200.0, WaterBody::None));
 }
 
 #[test]

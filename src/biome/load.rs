@@ -12,6 +12,7 @@ use toml::{Spanned, Value};
 use super::error::{BiomeError, Location, Problem};
 use super::names::{overworld_biome, suggest_biome, suggest_key};
 use super::rules::{Axis, Bounds, Table};
+use super::WaterBody;
 
 /// Shorthand for `surface_m` measured downwards, so ocean rules read like ocean charts.
 const DEPTH_KEY: &str = "depth_m";
@@ -29,6 +30,7 @@ pub(crate) const RULE_KEYS: &[&str] = &[
     "surface_m",
     DEPTH_KEY,
     "slope_deg",
+    "water",
 ];
 
 /// What a range key must hold.
@@ -187,6 +189,11 @@ fn parse_rule(
                 bounds.hi[Axis::Surface.lane()] = -lo;
                 depth_span = Some(key.span());
             }
+            "water" => {
+                let (lo, hi) = parse_water(value.get_ref()).map_err(|problem| fail(value.span(), problem))?;
+                bounds.lo[Axis::Water.lane()] = lo;
+                bounds.hi[Axis::Water.lane()] = hi;
+            }
             other => {
                 let Some(&axis) = Axis::ALL.iter().find(|a| a.key() == other) else {
                     let problem =
@@ -248,6 +255,42 @@ fn parse_range(key: &'static str, value: &Value, limits: (f32, f32)) -> Result<(
         return bad(format!("min {lo} is not below max {hi} (ranges are [min, max): min included, max excluded)"));
     }
     Ok((lo32, hi32))
+}
+
+/// What `water` must hold.
+const WATER_SHAPE: &str = "a water kind (\"sea\", \"lake\", \"river\", \"none\" or \"dry_lake\") or a list of them";
+
+/// A `water` condition: one kind or a list of kinds, as the range of their codes. A list must
+/// be gapless in [`WaterBody`]'s order, since a rule is one box.
+fn parse_water(value: &Value) -> Result<(f32, f32), Problem> {
+    let wrong = || Problem::WrongType { key: "water".into(), expected: WATER_SHAPE };
+    let names: Vec<&Value> = match value {
+        Value::Array(items) if !items.is_empty() => items.iter().collect(),
+        Value::String(_) => vec![value],
+        _ => return Err(wrong()),
+    };
+    let mut codes = Vec::with_capacity(names.len());
+    for name in names {
+        let Value::String(name) = name else { return Err(wrong()) };
+        let Some(kind) = WaterBody::ALL.iter().find(|w| w.key() == name) else {
+            let keys: Vec<&str> = WaterBody::ALL.iter().map(|w| w.key()).collect();
+            let why = format!("unknown water kind \"{name}\" (known: {})", keys.join(", "));
+            return Err(Problem::BadRange { key: "water", why });
+        };
+        codes.push(*kind as u8);
+    }
+    codes.sort_unstable();
+    codes.dedup();
+    let (lo, hi) = (codes[0], codes[codes.len() - 1]);
+    if usize::from(hi - lo) + 1 != codes.len() {
+        let order: Vec<&str> = WaterBody::ALL.iter().map(|w| w.key()).collect();
+        let why = format!(
+            "a rule's water kinds must be neighbours in the order {} (a rule is one range); write two rules",
+            order.join(", ")
+        );
+        return Err(Problem::BadRange { key: "water", why });
+    }
+    Ok((f32::from(lo), f32::from(hi) + 1.0))
 }
 
 /// Names are unique across all files: messages and the overlap advice refer to rules by name.

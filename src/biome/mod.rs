@@ -48,6 +48,47 @@ pub struct Conditions {
     pub surface_m: f32,
     /// Surface slope, degrees (0 flat .. 90).
     pub slope_deg: f32,
+    /// The water the cell's columns hold.
+    pub water: WaterBody,
+}
+
+/// The water body of a biome cell, for a rule's `water` condition.
+///
+/// The order is the one a rule's list must follow without gaps (`water = ["lake", "river"]`
+/// is fine, `["sea", "river"]` is two rules): it puts together the sets rules want — any
+/// water (`sea` … `river`), fresh water (`lake`, `river`), land with or without a dry lake
+/// bed (`none`, `dry_lake`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[repr(u8)]
+pub enum WaterBody {
+    /// The sea (the column's ground is under sea level).
+    Sea,
+    /// A lake above sea level.
+    Lake,
+    /// A river.
+    River,
+    /// No water: dry land.
+    #[default]
+    None,
+    /// A dry lake bed: a closed basin too dry to hold a lake (salt or clay flat).
+    DryLake,
+}
+
+impl WaterBody {
+    /// Every kind, in code order.
+    pub const ALL: [WaterBody; 5] =
+        [WaterBody::Sea, WaterBody::Lake, WaterBody::River, WaterBody::None, WaterBody::DryLake];
+
+    /// How a rule file names it.
+    pub fn key(self) -> &'static str {
+        match self {
+            WaterBody::Sea => "sea",
+            WaterBody::Lake => "lake",
+            WaterBody::River => "river",
+            WaterBody::None => "none",
+            WaterBody::DryLake => "dry_lake",
+        }
+    }
 }
 
 /// A validated, compiled set of biome rules.

@@ -1,10 +1,10 @@
 //! The compiled rule table: what a rule constrains, as boxes of half-open ranges, and the
 //! first-match lookup on the hot path.
 
-use super::Conditions;
+use super::{Conditions, WaterBody};
 
-/// Lanes of a compiled box: the seven axes padded to eight so a box is two 32-byte rows the
-/// compiler can compare with a few vector instructions and no branch per axis.
+/// Lanes of a compiled box: the eight axes, so a box is two 32-byte rows the compiler can
+/// compare with a few vector instructions and no branch per axis.
 pub(crate) const LANES: usize = 8;
 
 /// One physical quantity a rule can constrain.
@@ -17,11 +17,13 @@ pub(crate) enum Axis {
     Elevation,
     Surface,
     Slope,
+    /// The column's water body, as its [`WaterBody`] code (a rule names kinds, never codes).
+    Water,
 }
 
 impl Axis {
     /// Every axis, in lane order.
-    pub(crate) const ALL: [Axis; 7] = [
+    pub(crate) const ALL: [Axis; 8] = [
         Axis::Temperature,
         Axis::Seasonality,
         Axis::Precipitation,
@@ -29,6 +31,7 @@ impl Axis {
         Axis::Elevation,
         Axis::Surface,
         Axis::Slope,
+        Axis::Water,
     ];
 
     /// The lane this axis occupies in a compiled box.
@@ -46,6 +49,7 @@ impl Axis {
             Axis::Elevation => "elevation_m",
             Axis::Surface => "surface_m",
             Axis::Slope => "slope_deg",
+            Axis::Water => "water",
         }
     }
 
@@ -59,12 +63,13 @@ impl Axis {
             Axis::Variability => (0.0, 1_000.0),
             Axis::Elevation | Axis::Surface => (-12_000.0, 12_000.0),
             Axis::Slope => (0.0, 90.0),
+            Axis::Water => (0.0, WaterBody::ALL.len() as f32),
         }
     }
 }
 
 impl Conditions {
-    /// The conditions in lane order; the padding lane is 0, inside every box's (−inf, inf).
+    /// The conditions in lane order.
     #[inline]
     pub(crate) fn lanes(&self) -> [f32; LANES] {
         [
@@ -75,7 +80,7 @@ impl Conditions {
             self.elevation_m,
             self.surface_m,
             self.slope_deg,
-            0.0,
+            self.water as u8 as f32,
         ]
     }
 }
@@ -129,7 +134,14 @@ impl Bounds {
             .filter(|a| self.lo[a.lane()] > f32::NEG_INFINITY || self.hi[a.lane()] < f32::INFINITY)
             .map(|&a| {
                 let (lo, hi) = (self.lo[a.lane()], self.hi[a.lane()]);
-                if a == Axis::Surface && as_depth {
+                if a == Axis::Water {
+                    let kinds: Vec<&str> = WaterBody::ALL
+                        .iter()
+                        .filter(|w| (lo..hi).contains(&(**w as u8 as f32)))
+                        .map(|w| w.key())
+                        .collect();
+                    format!("water in [{}]", kinds.join(", "))
+                } else if a == Axis::Surface && as_depth {
                     // `0.0 - x` rather than `-x`: no "-0" in messages.
                     format!("depth_m in ({}, {}]", 0.0 - hi, 0.0 - lo)
                 } else {
@@ -194,6 +206,7 @@ mod tests {
             elevation_m: 100.0,
             surface_m: 100.0,
             slope_deg: 1.0,
+            water: WaterBody::None,
         }
     }
 

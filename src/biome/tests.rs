@@ -35,6 +35,7 @@ fn cell(temperature_c: f32, precipitation_mm: f32) -> Conditions {
         elevation_m: 200.0,
         surface_m: 200.0,
         slope_deg: 2.0,
+        water: WaterBody::None,
     }
 }
 
@@ -163,6 +164,36 @@ fn bad_ranges_name_the_key_and_why() {
         let message = one_file_error(&rule(range));
         assert!(message.starts_with("biomes/default.toml:5: rule \"r\": `"), "{message}");
         assert!(message.contains("must be [min, max]: two numbers"), "{range}: {message}");
+    }
+}
+
+#[test]
+fn water_conditions_name_kinds_and_lists_must_be_gapless() {
+    let text = format!(
+        "{FALLBACK}[[rule]]\nname = \"river\"\nbiome = \"minecraft:river\"\noverride = true\nwater = \"river\"\n\
+         [[rule]]\nname = \"fresh\"\nbiome = \"minecraft:swamp\"\nwater = [\"river\", \"lake\"]\n"
+    );
+    let rules = BiomeRules::from_sources(&[(PathBuf::from("biomes/default.toml"), text)]).unwrap();
+    let with = |water| rules.biome(&Conditions { water, ..cell(10.0, 800.0) });
+    assert_eq!(with(WaterBody::River), "minecraft:river");
+    assert_eq!(with(WaterBody::Lake), "minecraft:swamp");
+    assert_eq!(with(WaterBody::None), "minecraft:plains");
+    assert_eq!(with(WaterBody::Sea), "minecraft:plains");
+
+    let rule = |water: &str| format!("{FALLBACK}[[rule]]\nname = \"r\"\nbiome = \"minecraft:river\"\n{water}\n");
+    let cases = [
+        (
+            "water = \"stream\"",
+            "bad range `water`: unknown water kind \"stream\" (known: sea, lake, river, none, dry_lake)",
+        ),
+        ("water = [\"sea\", \"river\"]", "must be neighbours in the order sea, lake, river, none, dry_lake"),
+        ("water = 3", "`water` must be a water kind"),
+        ("water = []", "`water` must be a water kind"),
+    ];
+    for (water, expected) in cases {
+        let message = one_file_error(&rule(water));
+        assert!(message.starts_with("biomes/default.toml:5: rule \"r\": "), "{message}");
+        assert!(message.contains(expected), "{water}: {message}");
     }
 }
 
@@ -389,6 +420,7 @@ fn a_hundred_thousand_lookups_stay_linear() {
             elevation_m: (i % 41) as f32 * 100.0 - 1000.0,
             surface_m: (i % 41) as f32 * 100.0 - 1000.0,
             slope_deg: (i % 13) as f32,
+            water: WaterBody::None,
         };
         *counts.entry(rules.biome(&c)).or_insert(0u32) += 1;
     }

@@ -5,10 +5,10 @@
 //! (or the sea surface) share the column's conditions; cells in the air above it are colder
 //! by the lapse rate, so high air over a warm valley can still be a snowy biome.
 
-use crate::biome::Conditions;
+use crate::biome::{Conditions, WaterBody};
 use crate::terrain::pipeline::channel;
 
-use super::columns::Columns;
+use super::columns::{Columns, Water};
 use super::Vertical;
 
 /// Edge of a biome cell, blocks.
@@ -53,6 +53,31 @@ pub fn conditions(
         elevation_m,
         surface_m,
         slope_deg: columns.slope_deg(x, z),
+        water: water_body(columns, x, z),
+    }
+}
+
+/// The water of the cell whose sample column is (`x`, `z`): a river or lake if any of its
+/// 4×4 columns holds one (rivers are a few blocks wide, narrower than a cell, and a river
+/// biome along the banks is what vanilla does too), else the sample column's own.
+fn water_body(columns: &Columns, x: i64, z: i64) -> WaterBody {
+    let cell = (z - CELL / 2..z + CELL / 2).flat_map(|cz| (x - CELL / 2..x + CELL / 2).map(move |cx| (cx, cz)));
+    let mut lake = false;
+    for (cx, cz) in cell {
+        match columns.water(cx, cz) {
+            Water::River => return WaterBody::River,
+            Water::Lake => lake = true,
+            _ => {}
+        }
+    }
+    if lake {
+        WaterBody::Lake
+    } else if columns.water(x, z) == Water::Sea {
+        WaterBody::Sea
+    } else if columns.is_dry_bed(x, z) {
+        WaterBody::DryLake
+    } else {
+        WaterBody::None
     }
 }
 

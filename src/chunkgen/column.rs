@@ -62,7 +62,9 @@ impl Generator {
             let crowded = [(1, 0), (-1, 0), (0, 1), (0, -1)]
                 .into_iter()
                 .any(|(dx, dz)| columns.surface_y(x + dx, z + dz) >= base_y || candidate(x + dx, z + dz).is_some());
-            if near_tree || crowded {
+            // Sugar cane grows on banks (see passes/aquatic.rs): a cactus keeps away from water.
+            let by_water = (-2..=2).any(|dz| (-2..=2).any(|dx| columns.is_wet(x + dx, z + dz)));
+            if near_tree || crowded || by_water {
                 return None;
             }
         }
@@ -156,6 +158,10 @@ impl Generator {
         surface::ground(&Site {
             biome,
             water_depth: columns.water_depth(x, z),
+            water: columns.water(x, z),
+            discharge_m3s: columns.get(channel::DISCHARGE, x, z),
+            dry_bed: columns.is_dry_bed(x, z),
+            precipitation_mm: columns.get(channel::PRECIPITATION, x, z),
             drop_blocks: columns.drop_blocks(x, z),
             temperature_c: columns.get(channel::TEMPERATURE, x, z),
             seed: self.seed,
@@ -173,7 +179,8 @@ fn tree_rect(x0: i64, z0: i64, size: i64) -> Rect {
         let (first_root, last_root) = (lo - trees::REACH, lo + size - 1 + trees::REACH);
         let first_sample = cells::sample_column(first_root.div_euclid(CELL), 0).0;
         let last_sample = cells::sample_column(last_root.div_euclid(CELL), 0).0;
-        let start = (first_root - 1).min(first_sample - 1);
+        // Whole biome cells: a cell's water condition looks at all its 4×4 columns.
+        let start = (first_root - 1).min(first_sample - CELL / 2);
         (start, (last_root + 1).max(last_sample + 1) - start + 1)
     };
     let ((x, w), (z, h)) = (span(x0), span(z0));

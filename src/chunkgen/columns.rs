@@ -160,13 +160,17 @@ impl Columns {
         self.get(channel::RELIEF_SLOPE, x, z)
     }
 
-    /// How many blocks the ground falls from this column to its lowest 4-neighbour (0 when no
-    /// neighbour is lower): the face a player sees, which decides bare rock.
+    /// How many blocks the ground falls from this column to its lowest 4-neighbour's ground
+    /// or water top (0 when no neighbour is lower): the face a player sees, which decides
+    /// bare rock. A river's bank is not a cliff because its channel is deep.
     pub fn drop_blocks(&self, x: i64, z: i64) -> i32 {
         let y = self.surface_y(x, z);
         [(1, 0), (-1, 0), (0, 1), (0, -1)]
             .iter()
-            .map(|&(ox, oz)| y - self.surface_y(x + ox, z + oz))
+            .map(|&(ox, oz)| {
+                let (nx, nz) = (x + ox, z + oz);
+                y - self.surface_y(nx, nz).max(self.water_top_y(nx, nz).unwrap_or(i32::MIN))
+            })
             .max()
             .unwrap_or(0)
             .max(0)

@@ -145,7 +145,7 @@ fn dampening(block: BlockState) -> u8 {
         0
     } else if block.is_opaque() {
         15
-    } else if block.is_liquid() || !block.is_replaceable() {
+    } else if block.is_liquid() || !block.is_replaceable() || block == BlockState::SEAGRASS {
         1
     } else {
         0

@@ -104,3 +104,5 @@ mod tests;
 
 #[cfg(test)]
 mod pinned_tests;
+#[cfg(test)]
+mod water_tests;

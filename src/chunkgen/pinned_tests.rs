@@ -117,10 +117,10 @@ fn hash_biomes(chunk: &UnloadedChunk, h: &mut Fnv) {
 const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
-/// world with the shipped biome rules) outside the shallow sea, recorded before the sea fix.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0xdc55_00ea_4dba_dfd1;
-/// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], recorded after the sea fix.
-const PROCEDURAL_HASH: u64 = 0xdfad_7d6d_2a2d_5139;
+/// world with the shipped biome rules) outside the shallow sea, re-recorded with rivers and lakes (issue 25).
+const OUTSIDE_SHALLOWS_HASH: u64 = 0x032c_9713_2931_b772;
+/// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded with rivers and lakes (issue 25).
+const PROCEDURAL_HASH: u64 = 0xaeba_c0d7_5ff7_462a;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]

@@ -52,6 +52,8 @@ pub fn is_plant(block: BlockState) -> bool {
             | "azure_bluet"
             | "allium"
             | "pink_petals"
+            | "sugar_cane"
+            | "lily_pad"
     )
 }
 

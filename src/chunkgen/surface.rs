@@ -5,6 +5,7 @@
 
 use valence::prelude::BlockState;
 
+use super::columns::Water;
 use super::hash::value_noise;
 
 /// Everything the choice depends on for one column.
@@ -14,6 +15,14 @@ pub struct Site<'a> {
     pub biome: &'a str,
     /// Blocks of water above the surface block (0 on land, at least 1 under the sea).
     pub water_depth: i32,
+    /// The water over the column ([`Water::Dry`] on land).
+    pub water: Water,
+    /// Discharge of the river or lake over the column, m³/s (0 elsewhere).
+    pub discharge_m3s: f32,
+    /// The bed of a dry lake (a closed basin too arid to fill).
+    pub dry_bed: bool,
+    /// Annual precipitation, mm.
+    pub precipitation_mm: f32,
     /// Blocks the ground falls to its lowest neighbour (see `Columns::drop_blocks`).
     pub drop_blocks: i32,
     /// Annual mean air temperature at the surface, °C.
@@ -49,7 +58,15 @@ pub const POWDER_SNOW_C: f32 = -12.0;
 /// Below this temperature the sea surface freezes, °C.
 pub const SEA_ICE_C: f32 = 0.0;
 
+/// Discharge from which a river's bed is sand (big lowland rivers carry sand; small, steep
+/// ones leave gravel), m³/s.
+pub const SANDY_RIVER_M3S: f32 = 100.0;
+/// Annual precipitation under which a dry lake bed is a salt flat rather than clay, mm.
+pub const SALT_FLAT_MM: f32 = 250.0;
+
 const NOISE_POWDER: u64 = 0x5057_4452;
+const NOISE_BED: u64 = 0x4245_4453;
+const NOISE_CLAY: u64 = 0x434C_4159;
 
 /// Chooses the ground of one column.
 pub fn ground(site: &Site) -> Ground {
@@ -58,7 +75,13 @@ pub fn ground(site: &Site) -> Ground {
     let layer = |top, filler, filler_depth| Ground { top, filler, filler_depth, banded: false };
 
     if site.water_depth > 0 {
+        if matches!(site.water, Water::River | Water::Lake) {
+            return fresh_bed(site);
+        }
         return underwater(b, site.water_depth, site.temperature_c);
+    }
+    if site.dry_bed {
+        return dry_lake_bed(site);
     }
     if b.contains("badlands") {
         // Badlands show their banded terracotta on every slope; red sand only on flats.
@@ -105,6 +128,39 @@ fn underwater(biome: &str, depth: i32, temperature_c: f32) -> Ground {
     Ground { top, filler: top, filler_depth: 3, banded: false }
 }
 
+/// The bed of a river or lake: mud in warm, wet climates; gravel where cold; in rivers,
+/// gravel and sand by flow (sand from [`SANDY_RIVER_M3S`]); in lakes sand, with patches of
+/// clay in both (vanilla's clay disks).
+fn fresh_bed(site: &Site) -> Ground {
+    let patch = |key, scale| value_noise(site.seed, key, site.x, site.z, scale);
+    let top = if site.temperature_c >= 18.0 && site.precipitation_mm >= 1500.0 {
+        BlockState::MUD
+    } else if site.temperature_c < SEA_ICE_C {
+        BlockState::GRAVEL
+    } else if patch(NOISE_CLAY, 5) > 0.75 {
+        BlockState::CLAY
+    } else if site.water == Water::Lake {
+        BlockState::SAND
+    } else {
+        // The share of gravel falls from about three quarters in small streams to none in
+        // rivers of SANDY_RIVER_M3S.
+        let smallness = (SANDY_RIVER_M3S / site.discharge_m3s.max(0.5)).log10() / (SANDY_RIVER_M3S / 0.5).log10();
+        let gravel = 0.75 * smallness.clamp(0.0, 1.0);
+        if patch(NOISE_BED, 3) < gravel {
+            BlockState::GRAVEL
+        } else {
+            BlockState::SAND
+        }
+    };
+    Ground { top, filler: top, filler_depth: 2, banded: false }
+}
+
+/// The bed of a dry lake: a white salt flat (calcite) where very dry, a clay flat otherwise.
+fn dry_lake_bed(site: &Site) -> Ground {
+    let top = if site.precipitation_mm < SALT_FLAT_MM { BlockState::CALCITE } else { BlockState::CLAY };
+    Ground { top, filler: BlockState::CLAY, filler_depth: 2, banded: false }
+}
+
 /// The terracotta of badlands band at block `y` (repeating every 16 blocks, like strata).
 pub fn terracotta_band(y: i32) -> BlockState {
     const BANDS: [BlockState; 16] = [
@@ -133,7 +189,19 @@ mod tests {
     use super::*;
 
     fn site(biome: &str) -> Site<'_> {
-        Site { biome, water_depth: 0, drop_blocks: 0, temperature_c: 15.0, seed: 1, x: 0, z: 0 }
+        Site {
+            biome,
+            water_depth: 0,
+            water: Water::Dry,
+            discharge_m3s: 0.0,
+            dry_bed: false,
+            precipitation_mm: 800.0,
+            drop_blocks: 0,
+            temperature_c: 15.0,
+            seed: 1,
+            x: 0,
+            z: 0,
+        }
     }
 
     #[test]
@@ -179,6 +247,45 @@ mod tests {
         assert_eq!(wet("minecraft:deep_ocean", 40, 15.0), BlockState::GRAVEL);
         assert_eq!(wet("minecraft:cold_ocean", 3, 15.0), BlockState::GRAVEL);
         assert_eq!(wet("minecraft:warm_ocean", 40, 25.0), BlockState::SAND);
+    }
+
+    #[test]
+    fn river_beds_are_gravel_in_streams_and_sand_in_big_rivers_with_clay_patches_and_lakes_are_sandy() {
+        let beds = |water, discharge_m3s, temperature_c, precipitation_mm| {
+            let mut counts = std::collections::HashMap::new();
+            for (x, z) in (0..64).flat_map(|x| (0..64).map(move |z| (x, z))) {
+                let site = Site {
+                    water,
+                    discharge_m3s,
+                    temperature_c,
+                    precipitation_mm,
+                    water_depth: 2,
+                    x,
+                    z,
+                    ..site("minecraft:river")
+                };
+                *counts.entry(ground(&site).top).or_insert(0) += 1;
+            }
+            counts
+        };
+        let stream = beds(Water::River, 1.0, 12.0, 800.0);
+        let big = beds(Water::River, 500.0, 12.0, 800.0);
+        let share = |c: &std::collections::HashMap<BlockState, i32>, b| f64::from(*c.get(&b).unwrap_or(&0)) / 4096.0;
+        assert!(share(&stream, BlockState::GRAVEL) > 0.3, "{stream:?}");
+        assert_eq!(share(&big, BlockState::GRAVEL), 0.0, "{big:?}");
+        assert!(share(&big, BlockState::SAND) > 0.6, "{big:?}");
+        assert!(share(&big, BlockState::CLAY) > 0.0, "{big:?}");
+        let lake = beds(Water::Lake, 20.0, 12.0, 800.0);
+        assert!(share(&lake, BlockState::SAND) > 0.6 && !lake.contains_key(&BlockState::GRAVEL), "{lake:?}");
+        assert_eq!(beds(Water::River, 5.0, -5.0, 800.0).len(), 1, "cold beds are gravel only");
+        assert!(beds(Water::River, 5.0, 25.0, 2500.0).contains_key(&BlockState::MUD), "tropical rivers are muddy");
+    }
+
+    #[test]
+    fn dry_lake_beds_are_salt_flats_where_arid_and_clay_otherwise() {
+        let dry = |precipitation_mm| ground(&Site { dry_bed: true, precipitation_mm, ..site("minecraft:desert") }).top;
+        assert_eq!(dry(100.0), BlockState::CALCITE);
+        assert_eq!(dry(400.0), BlockState::CLAY);
     }
 
     #[test]

@@ -47,6 +47,19 @@ fn top(chunk: &UnloadedChunk, v: &Vertical, lx: u32, lz: u32) -> (i32, BlockStat
         .map_or((v.min_y, BlockState::AIR), |(y, b)| (y as i32 + v.min_y, b))
 }
 
+/// Highest ground block of a chunk column under any water and what grows in it: (world Y,
+/// block).
+fn ground(chunk: &UnloadedChunk, v: &Vertical, lx: u32, lz: u32) -> (i32, BlockState) {
+    let wet = |b: BlockState| {
+        b.is_liquid() || matches!(b, BlockState::ICE | BlockState::SEAGRASS | BlockState::KELP | BlockState::KELP_PLANT)
+    };
+    (0..chunk.height())
+        .rev()
+        .map(|y| (y, chunk.block_state(lx, y, lz)))
+        .find(|(_, b)| !b.is_air() && !is_tree(*b) && !is_plant(*b) && !wet(*b))
+        .map_or((v.min_y, BlockState::AIR), |(y, b)| (y as i32 + v.min_y, b))
+}
+
 #[test]
 fn chunks_agree_with_the_surface_function_across_chunk_borders() {
     let (g, rules, palette) = (generator(11), rules(), palette());
@@ -58,14 +71,12 @@ fn chunks_agree_with_the_surface_function_across_chunk_borders() {
                 let (x, z) = (i64::from(cx) * 16 + i64::from(lx), i64::from(cz) * 16 + i64::from(lz));
                 let s = g.surface(&rules, x, z);
                 let (top_y, top_block) = top(&chunk, &v, lx, lz);
-                if s.y >= v.water_top_y() {
-                    assert_eq!(top_y, s.y, "column ({x}, {z})");
-                    assert_eq!(top_block.to_kind().to_str(), s.top, "column ({x}, {z})");
-                } else {
+                let (ground_y, ground_block) = ground(&chunk, &v, lx, lz);
+                assert_eq!(ground_y, s.y, "column ({x}, {z})");
+                assert_eq!(ground_block.to_kind().to_str(), s.top, "column ({x}, {z})");
+                if s.y < v.water_top_y() {
                     assert_eq!(top_y, v.water_top_y(), "sea column ({x}, {z})");
                     assert!(matches!(top_block, BlockState::WATER | BlockState::ICE));
-                    let floor = chunk.block_state(lx, (s.y - v.min_y) as u32, lz);
-                    assert_eq!(floor.to_kind().to_str(), s.top, "sea floor ({x}, {z})");
                 }
                 let cell_y = ((s.y - v.min_y) / 4) as u32;
                 assert_eq!(chunk.biome(lx / 4, cell_y, lz / 4), palette.id(&s.biome), "biome at ({x}, {}, {z})", s.y);
@@ -142,6 +153,9 @@ fn check_sea_column(
     let (ground_y, ground) = top(chunk, v, lx, lz);
     let elevation = columns.elevation(x, z);
     if elevation >= 0.0 {
+        if columns.is_wet(x, z) {
+            return None; // a river or lake (tests in water_tests.rs)
+        }
         assert!(ground_y >= v.sea_level_y && !ground.is_liquid(), "land ({x}, {z}) at {elevation} m: {ground:?}");
         return None;
     }
@@ -149,7 +163,9 @@ fn check_sea_column(
     assert!(floor_y < v.water_top_y(), "sea ({x}, {z}) at {elevation} m has its ground at Y {floor_y}");
     assert!(!at(floor_y).is_air() && !at(floor_y).is_liquid(), "sea floor ({x}, {z}): {:?}", at(floor_y));
     for y in floor_y + 1..v.water_top_y() {
-        assert_eq!(at(y), BlockState::WATER, "sea ({x}, {y}, {z}) at {elevation} m");
+        let b = at(y);
+        let growing = matches!(b, BlockState::SEAGRASS | BlockState::KELP | BlockState::KELP_PLANT);
+        assert!(b == BlockState::WATER || growing, "sea ({x}, {y}, {z}) at {elevation} m: {b:?}");
     }
     let frozen = columns.get(channel::TEMPERATURE, x, z) < surface::SEA_ICE_C;
     let want = if frozen { BlockState::ICE } else { BlockState::WATER };
@@ -429,7 +445,7 @@ fn timed_chunks_are_the_same_chunks_and_time_every_pass_in_order() {
     let plain = g.chunk(&rules, &palette, -2, 5);
     let names: Vec<&str> = timings.iter().map(|t| t.name).collect();
     assert_eq!(names, passes::PASSES.iter().map(|p| p.name).collect::<Vec<_>>());
-    assert_eq!(names, ["columns", "rock", "water", "caves", "ores", "surface", "vegetation"]);
+    assert_eq!(names, ["columns", "rock", "water", "caves", "ores", "surface", "vegetation", "aquatic"]);
     assert!(timings.iter().any(|t| t.nanos > 0));
     for y in 0..plain.height() {
         for z in 0..16 {

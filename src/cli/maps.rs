@@ -8,7 +8,7 @@ use super::progress::Progress;
 use super::{world_sources, Failure, Size, Sources};
 use crate::chunkgen::Generator;
 use crate::config::Config;
-use crate::export::{self, ExportRequest, Grid, Vertical};
+use crate::export::{self, ExportRequest, Grid, Quantity, Vertical};
 use crate::lab::relief_compare::{self, CompareRequest};
 use crate::render::{self, Layer, ObliqueRequest, RenderRequest};
 use crate::terrain::model_files::ModelFiles;
@@ -26,6 +26,14 @@ pub struct AreaArgs {
     /// Size in blocks: `W` or `WxH`.
     #[arg(long)]
     pub size: Size,
+}
+
+/// Arguments of `infiniterra water`.
+#[derive(Debug, Args)]
+pub struct WaterArgs {
+    /// The rectangle of the world.
+    #[command(flatten)]
+    pub area: AreaArgs,
 }
 
 /// Arguments of `infiniterra render`.
@@ -78,6 +86,10 @@ pub struct ExportArgs {
     /// `block`: one value per block column; `model`: one per model pixel (4×4 blocks).
     #[arg(long, default_value = "block")]
     pub grid: Grid,
+    /// What to write: elevation (metres), water-level (river and lake surface, metres, NaN
+    /// where none) or discharge (m³/s); the water ones on the block grid.
+    #[arg(long, value_enum, default_value_t = Quantity::Elevation)]
+    pub quantity: Quantity,
     /// Output `.npy` (a `.json` with the same stem is written beside it).
     #[arg(long)]
     pub out: PathBuf,
@@ -94,6 +106,49 @@ fn classify<E: std::error::Error + Send + Sync + 'static>(bad_input: bool, e: E)
 
 fn pipeline(config: &Config, models: &ModelFiles) -> Result<Pipeline, Failure> {
     Pipeline::build_with_models(config.world.seed, &config.terrain(), models).map_err(Failure::input)
+}
+
+/// Runs `water`: the region's river and lake shares, river density and river ends, as a
+/// Markdown table.
+pub fn water(config: &Config, sources: &Sources, a: &WaterArgs) -> Result<(), Failure> {
+    let (_, models) = world_sources(config, sources, None);
+    let pipeline = pipeline(config, &models)?;
+    let area = crate::terrain::Rect::new(a.area.z0, a.area.x0, a.area.size.height, a.area.size.width);
+    let mut progress = Progress::new("water", "tiles");
+    let s = crate::lab::water::measure(&pipeline, area, |d, t| progress.update(d, t));
+    progress.finish();
+    let km = |blocks: i64| blocks as f64 * pipeline.block_metres() / 1000.0;
+    let (d01, drawn) = s.density();
+    let ends = s.ends_pct();
+    println!(
+        "water of x {}..{}, z {}..{} ({:.0} × {:.0} km, seed {}, stages: {})",
+        area.x0,
+        area.x1(),
+        area.y0,
+        area.y1(),
+        km(area.w),
+        km(area.h),
+        config.world.seed,
+        pipeline.active_stages().join(", ")
+    );
+    println!();
+    println!("| measure | generated |");
+    println!("|---|---|");
+    println!("| land columns | {} |", s.land_columns);
+    println!("| river water, % of land columns | {:.2} |", s.river_pct());
+    println!("| lake water, % of land columns | {:.2} |", s.lake_pct());
+    println!("| dry lake bed, % of land columns | {:.2} |", s.dry_bed_pct());
+    println!("| river length ≥ 0.1 m³/s, km per 1,000 km² of land | {d01:.0} |");
+    println!(
+        "| river length ≥ {} m³/s (drawn), km per 1,000 km² | {drawn:.0} |",
+        crate::terrain::hydrology::RIVER_DISCHARGE
+    );
+    println!("| drawn river length ending in the sea, % | {:.1} |", ends[0]);
+    println!("| … in a lake, % | {:.1} |", ends[1]);
+    println!("| … in a dry basin, % | {:.1} |", ends[2]);
+    println!("| … not ended within 400 km, % | {:.1} |", ends[3]);
+    println!("| land draining to the sea (exorheic), % | {:.1} |", s.exorheic_pct());
+    Ok(())
 }
 
 /// Runs `render`.
@@ -167,6 +222,7 @@ pub fn export(config: &Config, sources: &Sources, a: &ExportArgs) -> Result<(), 
         width: a.area.size.width,
         height: a.area.size.height,
         grid: a.grid,
+        quantity: a.quantity,
     };
     let vertical = Vertical {
         sea_level_y: config.world.sea_level_y as i32,

@@ -69,6 +69,8 @@ pub enum Command {
     Pregen(pregen::PregenArgs),
     /// Measure the engine and the pipeline on this machine.
     Bench(lab::BenchArgs),
+    /// Measure a region's rivers and lakes against real Earth's (docs/water.md).
+    Water(maps::WaterArgs),
 }
 
 /// A failure with the exit code it maps to.
@@ -199,5 +201,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
             pregen::run(&config, &sources, a)
         }
         Command::Bench(a) => crate::lab::bench::run(&load_config(&cli)?.0, &a.into()).map_err(Failure::runtime),
+        Command::Water(a) => {
+            let (config, sources) = load_config(&cli)?;
+            maps::water(&config, &sources, a)
+        }
     }
 }

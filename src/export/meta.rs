@@ -51,6 +51,33 @@ impl fmt::Display for Grid {
     }
 }
 
+/// What an export's values are.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Quantity {
+    /// Ground elevation, metres (river channels and valleys carved in at the block grid).
+    #[default]
+    Elevation,
+    /// Water surface of rivers and lakes, metres; NaN where there is none (block grid only;
+    /// the sea's is 0).
+    WaterLevel,
+    /// Discharge of the river or lake over the column, m³/s, 0 elsewhere: upstream area
+    /// weighted by runoff (block grid only).
+    Discharge,
+}
+
+impl Quantity {
+    /// The pipeline channel holding it.
+    pub fn channel(self) -> usize {
+        use crate::terrain::pipeline::channel;
+        match self {
+            Quantity::Elevation => channel::ELEVATION,
+            Quantity::WaterLevel => channel::WATER_LEVEL,
+            Quantity::Discharge => channel::DISCHARGE,
+        }
+    }
+}
+
 /// A grid name other than `block` or `model`.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("unknown grid `{given}` (allowed: block, model)")]
@@ -98,6 +125,9 @@ pub struct ExportMeta {
     pub metres_per_pixel: f64,
     /// World seed.
     pub seed: u64,
+    /// What the values are (older sidecars, without it, are elevation).
+    #[serde(default)]
+    pub quantity: Quantity,
     /// Pipeline stages that produced the values.
     pub stages: Vec<String>,
     /// The world's vertical scale.
@@ -174,6 +204,7 @@ mod tests {
             grid: Grid::Model,
             metres_per_pixel: 500.0,
             seed: u64::MAX,
+            quantity: Quantity::Discharge,
             stages: vec!["layout".into()],
             vertical: Vertical { sea_level_y: 63, metres_per_block: 25.0 },
         };

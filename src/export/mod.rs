@@ -9,10 +9,9 @@ mod meta;
 
 use std::path::{Path, PathBuf};
 
-pub use meta::{ExportMeta, Grid, UnknownGrid, Vertical};
+pub use meta::{ExportMeta, Grid, Quantity, UnknownGrid, Vertical};
 
 use crate::npy::NpyWriter;
-use crate::terrain::pipeline::channel;
 use crate::terrain::tile::div_floor;
 use crate::terrain::{Pipeline, Rect, Tile};
 
@@ -33,6 +32,8 @@ pub struct ExportRequest {
     pub height: i64,
     /// The grid to sample: every block column, or every model pixel covering the region.
     pub grid: Grid,
+    /// What to write.
+    pub quantity: Quantity,
 }
 
 /// What an export wrote.
@@ -76,6 +77,9 @@ pub enum ExportError {
     /// A vertical scale that cannot map metres to blocks.
     #[error("metres_per_block must be positive and finite (got {0})")]
     BadVertical(f64),
+    /// Water is decided at the block grid only.
+    #[error("--quantity {0:?} is only on the block grid (--grid block)")]
+    QuantityNeedsBlocks(Quantity),
     /// The output would collide with its own sidecar.
     #[error("the output {0} must not end in .json: the metadata is written beside it as FILE.json")]
     OutputIsJson(PathBuf),
@@ -115,6 +119,7 @@ impl ExportError {
                 | ExportError::OutOfRange { .. }
                 | ExportError::BadVertical(_)
                 | ExportError::OutputIsJson(_)
+                | ExportError::QuantityNeedsBlocks(_)
         )
     }
 }
@@ -136,12 +141,17 @@ pub fn export(
     if json == out {
         return Err(ExportError::OutputIsJson(out.to_path_buf()));
     }
-    // Elevation only: the climate channels would cost more than the terrain itself.
-    let mut query = |r: Rect| match req.grid {
-        Grid::Block => pipeline.elevation_columns(r),
-        Grid::Model => pipeline.elevation(r),
+    if req.quantity != Quantity::Elevation && req.grid != Grid::Block {
+        return Err(ExportError::QuantityNeedsBlocks(req.quantity));
+    }
+    // Elevation alone where it will do: the climate channels would cost more than the
+    // terrain itself.
+    let mut query = |r: Rect| match (req.grid, req.quantity) {
+        (Grid::Block, Quantity::Elevation) => pipeline.elevation_columns(r),
+        (Grid::Block, _) => pipeline.columns(r),
+        (Grid::Model, _) => pipeline.elevation(r),
     };
-    let (min, max) = write_array(out, rect, &mut query, progress)?;
+    let (min, max) = write_array(out, rect, req.quantity.channel(), &mut query, progress)?;
 
     let cell = req.grid.blocks_per_cell();
     let meta = ExportMeta {
@@ -152,6 +162,7 @@ pub fn export(
         grid: req.grid,
         metres_per_pixel: req.grid.metres_per_pixel(pipeline.block_metres()),
         seed: pipeline.seed(),
+        quantity: req.quantity,
         stages: pipeline.active_stages(),
         vertical: *vertical,
     };
@@ -173,11 +184,12 @@ fn cells(req: &ExportRequest) -> Result<Rect, ExportError> {
     Ok(Rect::new(z0, x0, z1 - z0 + 1, x1 - x0 + 1))
 }
 
-/// Streams channel 0 (elevation) of `rect` from `query` into the `.npy` at `path` in strips
-/// of rows; returns (min, max).
+/// Streams `channel` of `rect` from `query` into the `.npy` at `path` in strips of rows;
+/// returns (min, max), NaN ignored.
 fn write_array(
     path: &Path,
     rect: Rect,
+    channel: usize,
     query: &mut dyn FnMut(Rect) -> Tile,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(f32, f32), ExportError> {
@@ -193,12 +205,12 @@ fn write_array(
     while y < rect.y1() {
         let rows = strip_rows.min(rect.y1() - y);
         let tile = query(Rect::new(y, rect.x0, rows, rect.w));
-        let elevation = tile.channel(channel::ELEVATION);
-        for &v in elevation {
+        let values = tile.channel(channel);
+        for &v in values.iter().filter(|v| !v.is_nan()) {
             min = min.min(v);
             max = max.max(v);
         }
-        writer.write(elevation).map_err(write_err)?;
+        writer.write(values).map_err(write_err)?;
         y += rows;
         progress((y - rect.y0) as u64, rect.h as u64);
     }

@@ -3,12 +3,13 @@
 
 use super::*;
 use crate::npy::read_npy_f32;
+use crate::terrain::pipeline::channel;
 use crate::terrain::TerrainSettings;
 
 const VERTICAL: Vertical = Vertical { sea_level_y: 63, metres_per_block: 20.0 };
 
 fn request(grid: Grid) -> ExportRequest {
-    ExportRequest { x0: -37, z0: 21, width: 50, height: 30, grid }
+    ExportRequest { x0: -37, z0: 21, width: 50, height: 30, grid, quantity: Quantity::Elevation }
 }
 
 #[test]
@@ -16,7 +17,7 @@ fn model_grid_covers_every_block_with_floor_division() {
     // Blocks −37..=12 → model −10..=3; blocks 21..=50 → model 5..=12.
     assert_eq!(cells(&request(Grid::Model)).unwrap(), Rect::new(5, -10, 8, 14));
     assert_eq!(cells(&request(Grid::Block)).unwrap(), Rect::new(21, -37, 30, 50));
-    let one = ExportRequest { x0: -1, z0: 4, width: 1, height: 1, grid: Grid::Model };
+    let one = ExportRequest { x0: -1, z0: 4, width: 1, height: 1, grid: Grid::Model, quantity: Quantity::Elevation };
     assert_eq!(cells(&one).unwrap(), Rect::new(1, -1, 1, 1));
 }
 
@@ -44,7 +45,9 @@ fn streaming_in_strips_writes_every_row_in_order() {
         t
     };
     let mut last = (0, 0);
-    let (min, max) = write_array(&path, rect, &mut query, &mut |d, t| last = (d, t)).unwrap();
+    let (min, max) =
+        write_array(&path, rect, crate::terrain::pipeline::channel::ELEVATION, &mut query, &mut |d, t| last = (d, t))
+            .unwrap();
     assert_eq!(queries, 7, "one row per strip at this width");
     assert_eq!(last, (7, 7));
     assert_eq!((min, max), (-30.0, 36.0));
@@ -116,4 +119,21 @@ fn json_sidecar_has_every_field() {
     assert_eq!(v["stages"], serde_json::json!(pipeline.active_stages()));
     assert_eq!(v["vertical"]["sea_level_y"], 63);
     assert_eq!(v["vertical"]["metres_per_block"], 20.0);
+}
+
+#[test]
+fn water_quantities_are_block_grid_only_and_say_what_they_are() {
+    let pipeline = Pipeline::new(3, &TerrainSettings::default());
+    let dir = tempfile::tempdir().unwrap();
+    let vertical = Vertical { sea_level_y: 63, metres_per_block: 25.0 };
+    let out = dir.path().join("q.npy");
+    let model = ExportRequest { quantity: Quantity::Discharge, ..request(Grid::Model) };
+    let err = export(&pipeline, &model, &vertical, &out, &mut |_, _| {}).unwrap_err();
+    assert!(err.is_bad_input() && err.to_string().contains("--grid block"), "{err}");
+    let block = ExportRequest { quantity: Quantity::Discharge, ..request(Grid::Block) };
+    export(&pipeline, &block, &vertical, &out, &mut |_, _| {}).unwrap();
+    assert_eq!(ExportMeta::read(&ExportMeta::path_for(&out)).unwrap().quantity, Quantity::Discharge);
+    let values = read_npy_f32(&out).unwrap().1;
+    let columns = pipeline.columns(Rect::new(21, -37, 30, 50));
+    assert_eq!(values, columns.channel(channel::DISCHARGE));
 }

@@ -21,3 +21,4 @@ pub mod manifest_edit;
 pub mod relief_compare;
 #[cfg(feature = "learned")]
 pub mod train;
+pub mod water;

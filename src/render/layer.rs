@@ -62,7 +62,9 @@ impl fmt::Display for Layer {
 
 /// A layer name that is not one of [`Layer::ALL`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown layer `{given}` (allowed: elevation, temperature, precipitation, seasonality, variability, biome, water)")]
+#[error(
+    "unknown layer `{given}` (allowed: elevation, temperature, precipitation, seasonality, variability, biome, water)"
+)]
 pub struct UnknownLayer {
     /// The name as given.
     pub given: String,

@@ -7,12 +7,12 @@
 
 mod biomes;
 mod layer;
-mod water;
 mod oblique;
 pub(crate) mod panel;
 pub(crate) mod ramp;
 mod sample;
 pub(crate) mod shade;
+mod water;
 
 use std::path::{Path, PathBuf};
 
@@ -20,8 +20,8 @@ use image::{Rgb, RgbImage};
 
 pub use biomes::render_biomes;
 pub use layer::{Layer, UnknownLayer};
-pub use water::render_water;
 pub use oblique::{render_oblique, ObliqueRequest, MAX_OBLIQUE_SIDE};
+pub use water::render_water;
 
 use crate::terrain::pipeline::{channel, BLOCKS_PER_MODEL_PIXEL};
 use crate::terrain::tile::div_ceil;

@@ -157,7 +157,9 @@ fn model_cover(pipeline: &Pipeline, r: Rect) -> Tile {
 fn draw_courses(map: &mut RgbImage, courses: &[hydrology::Course], origin: (i64, i64), block_m: f64, px_m: f64) -> u64 {
     let mut drawn = 0;
     let (w, h) = (map.width() as f64, map.height() as f64);
-    let to_px = |(x, z): (f64, f64)| ((x / block_m - origin.0 as f64) * block_m / px_m, (z / block_m - origin.1 as f64) * block_m / px_m);
+    let to_px = |(x, z): (f64, f64)| {
+        ((x / block_m - origin.0 as f64) * block_m / px_m, (z / block_m - origin.1 as f64) * block_m / px_m)
+    };
     for course in courses {
         let radius = (hydrology::water_width_m(course.discharge, block_m) / px_m / 2.0).max(0.5);
         let shade = (course.discharge.max(0.1).log10() / 4.0).clamp(0.0, 1.0);

@@ -80,3 +80,24 @@ pub fn generator(config: &Config) -> Generator {
 pub fn short(biome: &str) -> &str {
     biome.strip_prefix("minecraft:").unwrap_or(biome)
 }
+
+/// River water columns within `radius` blocks (either axis) of `centre`: (x, z, block Y of
+/// the water's top), from the pipeline's water channels and the vertical mapping.
+#[allow(dead_code)]
+pub fn river_columns_near(generator: &Generator, centre: (i64, i64), radius: i64) -> Vec<(i64, i64, i32)> {
+    use infiniterra::terrain::hydrology::WaterColumns;
+    use infiniterra::terrain::pipeline::channel;
+    use infiniterra::terrain::Rect;
+    let rect = Rect::new(centre.1 - radius, centre.0 - radius, 2 * radius + 1, 2 * radius + 1);
+    let tile = generator.pipeline().columns(rect);
+    let mut out = Vec::new();
+    for z in rect.y0..rect.y1() {
+        for x in rect.x0..rect.x1() {
+            let level = tile.get(channel::WATER_LEVEL, z, x);
+            if tile.get(channel::WATER, z, x) as u8 == WaterColumns::RIVER && !level.is_nan() {
+                out.push((x, z, generator.vertical().surface_y(level)));
+            }
+        }
+    }
+    out
+}

@@ -104,7 +104,7 @@ function main () {
 // Blocks the generator places on the ground as vegetation (see src/fill/plants.rs).
 const PLANTS = new Set([
   'grass', 'tall_grass', 'fern', 'large_fern', 'dead_bush', 'cactus', 'sunflower', 'dandelion', 'poppy',
-  'cornflower', 'oxeye_daisy', 'azure_bluet', 'allium', 'pink_petals'
+  'cornflower', 'oxeye_daisy', 'azure_bluet', 'allium', 'pink_petals', 'sugar_cane', 'lily_pad'
 ])
 
 // The ground of column (x, z): its highest block that is neither air, a plant nor part of a tree, with

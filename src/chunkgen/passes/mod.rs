@@ -6,6 +6,7 @@
 //! rock). Each must be a pure function of global coordinates so that chunks meet without
 //! seams whatever order they are built in.
 
+mod aquatic;
 mod caves;
 mod columns;
 mod ores;
@@ -27,12 +28,13 @@ pub struct Pass {
 }
 
 /// Every pass, in order.
-pub const PASSES: [Pass; 7] = [
+pub const PASSES: [Pass; 8] = [
     // The pipeline's columns around the chunk and the biome of every 4×4×4 cell.
     Pass { name: "columns", run: columns::run },
     // Bedrock, then deepslate and stone up to every column's ground.
     Pass { name: "rock", run: rock::run },
-    // The sea: water from the sea floor to the water top, ice on top where cold.
+    // The sea, rivers and lakes: water from the ground to the water top, ice on top where
+    // cold, falling water where a river steps down.
     Pass { name: "water", run: water::run },
     // Caverns and tunnels (lava deep down), kept dry under and beside the sea: after the
     // rock and sea exist, before the surface is laid on what is left.
@@ -43,6 +45,8 @@ pub const PASSES: [Pass; 7] = [
     Pass { name: "surface", run: surface::run },
     // Trees, then plants where every block they need is still air.
     Pass { name: "vegetation", run: vegetation::run },
+    // Seagrass and kelp in the sea, lily pads on lakes, sugar cane on banks.
+    Pass { name: "aquatic", run: aquatic::run },
 ];
 
 /// Test support: contexts over synthetic columns, for the passes' unit tests.
@@ -54,6 +58,7 @@ pub(crate) mod testing {
     use crate::biome::BiomeRules;
     use crate::chunkgen::{BiomePalette, Columns, Generator};
     use crate::config::Config;
+    use crate::terrain::hydrology::WaterColumns;
     use crate::terrain::pipeline::channel;
     use crate::terrain::{Pipeline, Rect, Tile};
 
@@ -107,6 +112,24 @@ slope_deg = [8, 90]
             tile.channel_mut(channel::ELEVATION)[i] = elevation;
             tile.channel_mut(channel::TEMPERATURE)[i] = temperature;
             tile.channel_mut(channel::PRECIPITATION)[i] = 800.0;
+        }
+        Columns::from_tile(tile, g.vertical())
+    }
+
+    /// Columns over `rect` with elevation (m), temperature (°C) and a river's water level
+    /// (m, or `None`) given per column.
+    pub fn river_columns(g: &Generator, rect: Rect, f: impl Fn(i64, i64) -> (f32, f32, Option<f32>)) -> Columns {
+        let mut tile = Tile::zeros(channel::COUNT, rect);
+        let w = rect.w as usize;
+        for i in 0..rect.area() {
+            let (x, z) = (rect.x0 + (i % w) as i64, rect.y0 + (i / w) as i64);
+            let (elevation, temperature, level) = f(x, z);
+            tile.channel_mut(channel::ELEVATION)[i] = elevation;
+            tile.channel_mut(channel::TEMPERATURE)[i] = temperature;
+            tile.channel_mut(channel::PRECIPITATION)[i] = 800.0;
+            tile.channel_mut(channel::WATER_LEVEL)[i] = level.unwrap_or(f32::NAN);
+            tile.channel_mut(channel::WATER)[i] = if level.is_some() { f32::from(WaterColumns::RIVER) } else { 0.0 };
+            tile.channel_mut(channel::DISCHARGE)[i] = if level.is_some() { 5.0 } else { 0.0 };
         }
         Columns::from_tile(tile, g.vertical())
     }

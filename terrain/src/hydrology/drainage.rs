@@ -21,8 +21,10 @@ const EPSILON_M: f32 = 1e-3;
 /// Where a filled depression is this many metres deep or more it is a lake (or, in a basin
 /// too dry to fill, a dry lake bed). Shallower filling is a flat that drains: a 1 km grid's
 /// pits of a few metres are mostly the relief's noise, and as lakes they covered a tenth of
-/// wet lowlands and dry beds a fifth of deserts.
-pub const LAKE_MIN_DEPTH_M: f32 = 10.0;
+/// wet lowlands and dry beds a fifth of deserts; at 10 m lakes still held 10.6 % of the land
+/// of an inland region at the block grid (real land: 1.8 %, HydroLAKES). 25 m is one block of
+/// the default vertical scale: a shallower basin would be at most one block deep.
+pub const LAKE_MIN_DEPTH_M: f32 = 25.0;
 /// Seconds in a year (discharge is m³/s, climate mm/yr).
 const SECONDS_PER_YEAR: f64 = 365.25 * 86_400.0;
 

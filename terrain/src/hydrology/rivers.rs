@@ -6,7 +6,7 @@ use std::sync::Arc;
 use super::drainage::{Kind, D8, NO_DOWN};
 use super::{grid, CELL_METRES};
 use crate::infinite::Source;
-use crate::noise::hash3;
+use crate::noise::{gradient, hash3};
 use crate::tile::{Rect, Tile};
 
 /// Discharge (m³/s) from which a cell's water is a river a player sees: a stream of a few
@@ -31,8 +31,17 @@ const VALLEY_SLOPE: f64 = 0.2;
 /// How far beyond its floodplain a river's valley reaches, metres; past it the relief is
 /// untouched.
 const VALLEY_REACH_M: f64 = 640.0;
-/// How far around a lake cell (in cells) its water may spread into lower ground.
-const LAKE_REACH: f64 = 0.5;
+/// Interpolated basin indicator from which a basin's water fills all ground under its level.
+const SHORE_FULL: f64 = 0.6;
+/// Interpolated basin indicator below which there is no basin water.
+const SHORE_EDGE: f64 = 0.15;
+/// How far under a basin's level the ground must lie at [`SHORE_EDGE`], metres (linear from
+/// 0 at [`SHORE_FULL`]).
+const SHORE_RISE_M: f64 = 40.0;
+/// How far a shore point is displaced by noise, cells.
+const SHORE_WARP: f64 = 0.3;
+/// Frequency of the shore-warping noise, per cell.
+const SHORE_WARP_FREQ: f64 = 1.7;
 /// Channel depth at a river's centre, blocks, for the smallest river; one more per ×10
 /// discharge, at most [`MAX_DEPTH_BLOCKS`].
 const MAX_DEPTH_BLOCKS: f64 = 4.0;
@@ -219,12 +228,22 @@ impl Rivers {
                 }
                 if upstream == 0 {
                     // A source: the course starts at the node.
-                    out.push(Piece::new(centre, [(pc.0 + m.0) / 2.0, (pc.1 + m.1) / 2.0, q, (here + end[3]) / 2.0], end, block_m));
+                    out.push(Piece::new(
+                        centre,
+                        [(pc.0 + m.0) / 2.0, (pc.1 + m.1) / 2.0, q, (here + end[3]) / 2.0],
+                        end,
+                        block_m,
+                    ));
                 }
                 if matches!(cells.kind(dy, dx), Kind::Sea | Kind::Lake | Kind::Dry) {
                     // The mouth: on into the sea, the lake or the dry basin's bed.
                     let last = [pd.0, pd.1, q, there];
-                    out.push(Piece::new(end, [(m.0 + pd.0) / 2.0, (m.1 + pd.1) / 2.0, q, (end[3] + there) / 2.0], last, block_m));
+                    out.push(Piece::new(
+                        end,
+                        [(m.0 + pd.0) / 2.0, (m.1 + pd.1) / 2.0, q, (end[3] + there) / 2.0],
+                        last,
+                        block_m,
+                    ));
                 }
             }
         }
@@ -262,12 +281,12 @@ impl Rivers {
     pub fn columns(&self, blocks: Rect, block_m: f64, vertical_m: f64, elevation: &mut [f32]) -> WaterColumns {
         let n = blocks.area();
         let (lo, hi, nodes) = self.around(blocks, block_m);
-        let cell = |m: f64| (m / CELL_METRES).floor() as i64;
         let cells = Cells { tile: self.network(nodes.pad(1)) };
         let pieces: Vec<Piece> =
             self.pieces(&cells, nodes, block_m).into_iter().filter(|p| p.touches(lo, hi)).collect();
 
-        let mut out = WaterColumns { level: vec![f32::NAN; n], kind: vec![Kind::Land as u8; n], discharge: vec![0.0; n] };
+        let mut out =
+            WaterColumns { level: vec![f32::NAN; n], kind: vec![Kind::Land as u8; n], discharge: vec![0.0; n] };
         let mut i = 0;
         for z in blocks.y0..blocks.y1() {
             for x in blocks.x0..blocks.x1() {
@@ -296,36 +315,61 @@ impl Rivers {
                     out.kind[i] = WaterColumns::RIVER;
                     out.discharge[i] = q as f32;
                 }
-                // Lakes and dry beds: lower ground near a lake cell, under its level.
-                let (cy, cx) = (cell(zm), cell(xm));
-                let mut lake: Option<(f64, f64, f64)> = None;
-                for (oy, ox) in (-1..=1).flat_map(|a| (-1..=1).map(move |b| (a, b))) {
-                    let (ly, lx) = (cy + oy, cx + ox);
-                    if cells.kind(ly, lx) != Kind::Lake {
-                        continue;
+                // Lakes and dry beds: ground under a basin's level where the basin's cells
+                // (smoothly interpolated, warped) reach; see `basin_at`.
+                if let Some((kind, level, q)) = self.basin_at(&cells, xm, zm, e) {
+                    if kind == Kind::Lake || river.is_none() {
+                        out.level[i] = level as f32;
+                        out.kind[i] = kind as u8;
+                        out.discharge[i] = if kind == Kind::Lake { q as f32 } else { 0.0 };
                     }
-                    let gap = |p: f64, c: i64| {
-                        let (a, b) = (c as f64 * CELL_METRES, (c + 1) as f64 * CELL_METRES);
-                        (a - p).max(p - b).max(0.0)
-                    };
-                    let d = gap(xm, lx).hypot(gap(zm, ly));
-                    if d <= LAKE_REACH * CELL_METRES && lake.is_none_or(|l| d < l.0) {
-                        lake = Some((d, cells.level(ly, lx), cells.discharge(ly, lx)));
-                    }
-                }
-                if let Some((_, level, q)) = lake.filter(|l| e < l.1) {
-                    out.level[i] = level as f32;
-                    out.kind[i] = Kind::Lake as u8;
-                    out.discharge[i] = q as f32;
-                } else if river.is_none() && cells.kind(cy, cx) == Kind::Dry && e < cells.level(cy, cx) {
-                    out.level[i] = cells.level(cy, cx) as f32;
-                    out.kind[i] = Kind::Dry as u8;
                 }
                 elevation[i] = e as f32;
                 i += 1;
             }
         }
         out
+    }
+}
+
+impl Rivers {
+    /// The lake or dry basin (kind, level, discharge) whose water covers ground at `e`
+    /// metres at `(xm, zm)`, if any. A basin's cells (1 km) are spread into an indicator
+    /// interpolated between cell centres at a point warped by noise, so shores do not trace
+    /// the lattice: where the indicator is high the water fills all ground under the level;
+    /// towards its edge it needs ground ever further under it ([`SHORE_RISE_M`]), so on flat
+    /// ground the shore is the warped contour and on slopes it is the level's own contour.
+    fn basin_at(&self, cells: &Cells, xm: f64, zm: f64, e: f64) -> Option<(Kind, f64, f64)> {
+        let (cy, cx) = ((zm / CELL_METRES).floor() as i64, (xm / CELL_METRES).floor() as i64);
+        let basin = |y: i64, x: i64| matches!(cells.kind(y, x), Kind::Lake | Kind::Dry);
+        if !(-1..=1).any(|a| (-1..=1).any(|b| basin(cy + a, cx + b))) {
+            return None;
+        }
+        let (u, v) = (xm / CELL_METRES * SHORE_WARP_FREQ, zm / CELL_METRES * SHORE_WARP_FREQ);
+        let warp = SHORE_WARP * CELL_METRES;
+        let wx = xm + warp * gradient(self.seed ^ 0x5A0E, v, u);
+        let wz = zm + warp * gradient(self.seed ^ 0x5A0F, v + 17.0, u + 31.0);
+        // Interpolate between the four cell centres around the warped point.
+        let (fy, fx) = (wz / CELL_METRES - 0.5, wx / CELL_METRES - 0.5);
+        let (y0, x0) = (fy.floor() as i64, fx.floor() as i64);
+        let (ty, tx) = (smoothstep(fy - y0 as f64), smoothstep(fx - x0 as f64));
+        let mut best: Option<(f64, i64, i64)> = None;
+        let mut indicator = 0.0;
+        for (a, b, w) in
+            [(0, 0, (1.0 - ty) * (1.0 - tx)), (0, 1, (1.0 - ty) * tx), (1, 0, ty * (1.0 - tx)), (1, 1, ty * tx)]
+        {
+            let (y, x) = (y0 + a, x0 + b);
+            if basin(y, x) {
+                indicator += w;
+                if best.is_none_or(|(bw, _, _)| w > bw) {
+                    best = Some((w, y, x));
+                }
+            }
+        }
+        let (_, y, x) = best?;
+        let level = cells.level(y, x);
+        let rise = SHORE_RISE_M * ((SHORE_FULL - indicator) / (SHORE_FULL - SHORE_EDGE)).max(0.0);
+        (indicator > SHORE_EDGE && e + rise < level).then(|| (cells.kind(y, x), level, cells.discharge(y, x)))
     }
 }
 

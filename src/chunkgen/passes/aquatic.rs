@@ -1,0 +1,180 @@
+//! The aquatic pass: what grows by and in water, once the ground, the water and the land's
+//! plants are in place: seagrass and kelp on sea floors that are not frozen, lily pads on
+//! lakes and slow rivers in mild climates, sugar cane on the banks where ground meets water.
+//!
+//! Like every pass, a pure function of global coordinates: each choice hashes (seed, x, z)
+//! and reads only the column and its four neighbours, which the columns pass provides.
+
+use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+
+use crate::chunkgen::columns::Water;
+use crate::chunkgen::hash::{hash3, unit3};
+use crate::chunkgen::surface::SEA_ICE_C;
+use crate::chunkgen::ChunkContext;
+use crate::terrain::pipeline::channel;
+
+const SALT_AQUATIC: u64 = 0x6171_7561;
+const SALT_HEIGHT: u64 = 0x6865_6967;
+
+/// Chance of seagrass on a sea floor column 2–12 blocks deep.
+pub const SEAGRASS_CHANCE: f32 = 0.3;
+/// Chance of a kelp stalk on a sea floor column at least [`KELP_MIN_DEPTH`] deep, in seas of
+/// [`SEA_ICE_C`] … [`KELP_MAX_C`] (vanilla grows kelp in every ocean but the warm and frozen).
+pub const KELP_CHANCE: f32 = 0.06;
+/// The shallowest water kelp grows in, blocks.
+pub const KELP_MIN_DEPTH: i32 = 5;
+/// The warmest sea kelp grows in, °C (warm oceans have coral instead).
+pub const KELP_MAX_C: f32 = 24.0;
+/// Chance of a lily pad on a lake or slow river column.
+pub const LILY_PAD_CHANCE: f32 = 0.05;
+/// The fastest river lily pads float on, m³/s.
+pub const LILY_PAD_MAX_M3S: f32 = 20.0;
+/// Chance of sugar cane on a bank column (ground beside water at its own height).
+pub const SUGAR_CANE_CHANCE: f32 = 0.2;
+/// The coldest climate sugar cane grows in, °C.
+pub const SUGAR_CANE_MIN_C: f32 = 8.0;
+
+/// Places the aquatic plants of every column of the chunk.
+pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+    let (v, seed, columns) = (*ctx.vertical(), ctx.seed(), ctx.columns());
+    for (lx, lz, x, z) in ctx.each_column() {
+        let ground = columns.surface_y(x, z);
+        let temperature = columns.get(channel::TEMPERATURE, x, z);
+        let roll = unit3(seed, SALT_AQUATIC, x, 0, z);
+        let ly = |y: i32| (y - v.min_y) as u32;
+        let top = chunk.block_state(lx, ly(ground), lz);
+        match (columns.water(x, z), columns.water_top_y(x, z)) {
+            (Water::Sea, Some(water_top)) if temperature >= SEA_ICE_C => {
+                let depth = water_top - ground;
+                let floor = matches!(top, BlockState::SAND | BlockState::GRAVEL | BlockState::CLAY);
+                if !floor || chunk.block_state(lx, ly(ground + 1), lz) != BlockState::WATER {
+                    continue;
+                }
+                if depth >= KELP_MIN_DEPTH && temperature < KELP_MAX_C && roll < KELP_CHANCE {
+                    // A stalk that stops at least two blocks under the surface.
+                    let tall = 1 + (hash3(seed, SALT_HEIGHT, x, 0, z) % (depth - 2).clamp(1, 12) as u64) as i32;
+                    for y in ground + 1..ground + tall {
+                        chunk.set_block_state(lx, ly(y), lz, BlockState::KELP_PLANT);
+                    }
+                    chunk.set_block_state(lx, ly(ground + tall), lz, BlockState::KELP);
+                } else if (2..=12).contains(&depth) && roll < KELP_CHANCE + SEAGRASS_CHANCE {
+                    chunk.set_block_state(lx, ly(ground + 1), lz, BlockState::SEAGRASS);
+                }
+            }
+            (Water::Lake | Water::River, Some(water_top)) => {
+                let slow = columns.get(channel::DISCHARGE, x, z) <= LILY_PAD_MAX_M3S;
+                let open = chunk.block_state(lx, ly(water_top), lz) == BlockState::WATER
+                    && chunk.block_state(lx, ly(water_top + 1), lz).is_air()
+                    // Level water all round: not on a step of a river.
+                    && [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                        .iter()
+                        .all(|&(dx, dz)| columns.water_top_y(x + dx, z + dz).is_none_or(|t| t == water_top));
+                if slow && open && temperature >= SUGAR_CANE_MIN_C && roll < LILY_PAD_CHANCE {
+                    chunk.set_block_state(lx, ly(water_top + 1), lz, BlockState::LILY_PAD);
+                }
+            }
+            (Water::Dry, None) => {
+                // Sugar cane needs water beside the block it stands on.
+                let soil = matches!(
+                    top,
+                    BlockState::GRASS_BLOCK
+                        | BlockState::DIRT
+                        | BlockState::SAND
+                        | BlockState::RED_SAND
+                        | BlockState::MUD
+                );
+                let bank = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                    .iter()
+                    .any(|&(dx, dz)| columns.water_top_y(x + dx, z + dz) == Some(ground));
+                if !(soil && bank && temperature >= SUGAR_CANE_MIN_C && roll < SUGAR_CANE_CHANCE) {
+                    continue;
+                }
+                let tall = 1 + (hash3(seed, SALT_HEIGHT, x, 0, z) % 3) as i32;
+                let ys = (ground + 1..=ground + tall).map(ly);
+                if ys.clone().all(|y| y < v.height as u32 && chunk.block_state(lx, y, lz).is_air()) {
+                    for y in ys {
+                        chunk.set_block_state(lx, y, lz, BlockState::SUGAR_CANE);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing;
+    use super::*;
+    use crate::terrain::Rect;
+
+    /// Runs the rock-less passes that aquatic plants need (water, surface) over synthetic
+    /// columns, then this pass.
+    fn grow(f: impl Fn(i64, i64) -> (f32, f32), biome: &str) -> (UnloadedChunk, crate::chunkgen::Vertical) {
+        let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
+        let v = *g.vertical();
+        let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
+        ctx.columns = Some(testing::columns(&g, Rect::new(-4, -4, 24, 24), f));
+        ctx.biomes = vec![biome; 16 * ctx.cells_y()];
+        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        super::super::water::run(&mut ctx, &mut chunk);
+        super::super::surface::run(&mut ctx, &mut chunk);
+        run(&mut ctx, &mut chunk);
+        (chunk, v)
+    }
+
+    fn count(chunk: &UnloadedChunk, v: &crate::chunkgen::Vertical, block: BlockState) -> usize {
+        (0..16u32)
+            .flat_map(|x| (0..16u32).map(move |z| (x, z)))
+            .flat_map(|(x, z)| (0..v.height as u32).map(move |y| (x, y, z)))
+            .filter(|&(x, y, z)| chunk.block_state(x, y, z) == block)
+            .count()
+    }
+
+    #[test]
+    fn temperate_seas_grow_seagrass_and_kelp_and_frozen_seas_nothing() {
+        let (sea, v) = grow(|_, _| (-200.0, 12.0), "minecraft:ocean");
+        assert!(count(&sea, &v, BlockState::SEAGRASS) + count(&sea, &v, BlockState::KELP) > 20);
+        // Every kelp top stands on kelp stalk or on the floor, and has water above.
+        for (x, z) in (0..16u32).flat_map(|x| (0..16u32).map(move |z| (x, z))) {
+            for y in 1..v.height as u32 - 1 {
+                if sea.block_state(x, y, z) == BlockState::KELP {
+                    assert_eq!(sea.block_state(x, y + 1, z), BlockState::WATER, "kelp at the surface");
+                    assert!(sea.block_state(x, y - 1, z) != BlockState::WATER, "floating kelp");
+                }
+            }
+        }
+        let (frozen, v) = grow(|_, _| (-200.0, -5.0), "minecraft:frozen_ocean");
+        assert_eq!(count(&frozen, &v, BlockState::SEAGRASS) + count(&frozen, &v, BlockState::KELP), 0);
+    }
+
+    #[test]
+    fn sugar_cane_grows_on_banks_and_lily_pads_on_the_river() {
+        // A river along z 6..10 whose water stands at the land's height (Y 67), 4 blocks deep.
+        let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome("minecraft:plains"));
+        let v = *g.vertical();
+        let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
+        ctx.columns = Some(testing::river_columns(&g, Rect::new(-4, -4, 24, 24), |_, z| {
+            if (6..10).contains(&z) {
+                (0.0, 20.0, Some(100.0))
+            } else {
+                (100.0, 20.0, None)
+            }
+        }));
+        ctx.biomes = vec!["minecraft:plains"; 16 * ctx.cells_y()];
+        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        super::super::water::run(&mut ctx, &mut chunk);
+        super::super::surface::run(&mut ctx, &mut chunk);
+        run(&mut ctx, &mut chunk);
+        let ground = (67 - v.min_y) as u32;
+        let cane: Vec<(u32, u32)> = (0..16u32)
+            .flat_map(|x| (0..16u32).map(move |z| (x, z)))
+            .filter(|&(x, z)| chunk.block_state(x, ground + 1, z) == BlockState::SUGAR_CANE)
+            .collect();
+        assert!(cane.iter().all(|&(_, z)| z == 5 || z == 10), "sugar cane away from the banks: {cane:?}");
+        assert!(cane.len() >= 2, "{cane:?}");
+        let pads = (0..16u32).flat_map(|x| (6..10u32).map(move |z| (x, z)));
+        let pads = pads.filter(|&(x, z)| chunk.block_state(x, ground + 1, z) == BlockState::LILY_PAD).count();
+        assert!(pads >= 1, "no lily pad on a slow warm river");
+    }
+}
