@@ -124,7 +124,7 @@ impl Generator {
         let y = columns.surface_y(x, z);
         let biome = self.surface_biome(rules, &columns, x, z);
         let top = self.ground_at(&columns, biome, x, z).top;
-        SurfaceSample { y, biome: biome.to_string(), top: top.to_kind().to_str() }
+        SurfaceSample { y, biome: biome.to_string(), top: top.to_kind().to_str(), water_y: columns.water_top_y(x, z) }
     }
 
     /// The surface of every column of `rect` (row-major: z rows, x within a row), each exactly
@@ -146,6 +146,7 @@ impl Generator {
                     y: columns.surface_y(x, z),
                     biome: biome.to_string(),
                     top: top.to_kind().to_str(),
+                    water_y: columns.water_top_y(x, z),
                 });
             }
         }

@@ -97,6 +97,8 @@ pub struct SurfaceSample {
     pub biome: String,
     /// Name of the ground block there (`"grass_block"`), before any vegetation or sea ice.
     pub top: &'static str,
+    /// Block Y of the top of the water over the column (sea, river or lake), if any.
+    pub water_y: Option<i32>,
 }
 
 #[cfg(test)]

@@ -53,6 +53,8 @@ struct Column {
     top: [f32; 3],
     /// The colour of the few blocks under it.
     filler: [f32; 3],
+    /// Block Y of the water's top over it (sea, river or lake), or `i32::MIN` where dry.
+    water: i32,
 }
 
 /// Where the columns land on screen: half a block is `k` pixels, so a block's top is a
@@ -85,21 +87,20 @@ pub fn render_oblique(
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<RgbImage, RenderError> {
     check(req)?;
-    let water_top = generator.vertical().water_top_y();
     let mut columns = Vec::with_capacity((req.width * req.height) as usize);
     let mut counts: HashMap<String, u64> = HashMap::new();
     let mut top = 0;
     while top < req.height {
         let rows = STRIP_ROWS.min(req.height - top);
         for s in generator.surfaces(rules, Rect::new(req.z0 + top, req.x0, rows, req.width)) {
-            let name = if s.y < water_top { "water" } else { s.top };
+            let name = if s.water_y.is_some() { "water" } else { s.top };
             *counts.entry(name.to_string()).or_default() += 1;
             columns.push(column(&s));
         }
         top += rows;
         progress(top as u64, req.height as u64);
     }
-    let view = paint(&columns, (req.width, req.height), water_top);
+    let view = paint(&columns, (req.width, req.height));
     let pipeline = generator.pipeline();
     let v = generator.vertical();
     let title = [
@@ -148,7 +149,7 @@ fn column(s: &SurfaceSample) -> Column {
         "grass_block" => grass(&s.biome),
         name => block_colour(name),
     };
-    Column { ground: s.y, top, filler: block_colour(filler(s.top)) }
+    Column { ground: s.y, top, filler: block_colour(filler(s.top)), water: s.water_y.unwrap_or(i32::MIN) }
 }
 
 /// The blocks under a top block, for the cut-away faces.
@@ -215,12 +216,12 @@ const SOUTH_FACE: f32 = 0.6;
 const BLOCK_EDGE: f32 = 0.85;
 
 /// Paints `columns` (`width`×`height`, row-major from the north-west corner) back to front.
-fn paint(columns: &[Column], (width, height): (i64, i64), water_top: i32) -> RgbImage {
+fn paint(columns: &[Column], (width, height): (i64, i64)) -> RgbImage {
     let at = |i: i64, j: i64| &columns[(j * width + i) as usize];
-    // What hides the ground behind: the ground, or the sea surface over it.
-    let surface = |i: i64, j: i64| at(i, j).ground.max(water_top);
+    // What hides the ground behind: the ground, or the water surface over it.
+    let surface = |i: i64, j: i64| at(i, j).ground.max(at(i, j).water);
     let low = columns.iter().map(|c| c.ground).min().unwrap_or(0) - FOOT_BLOCKS;
-    let high = columns.iter().map(|c| c.ground.max(water_top)).max().unwrap_or(0);
+    let high = columns.iter().map(|c| c.ground.max(c.water)).max().unwrap_or(0);
     let k = (TARGET_WIDTH / (2 * (width + height))).clamp(1, 4);
     let origin_y = width * k + (high - low) as i64 * 2 * k;
     let p = Projection { k, floor: low, origin_y, width: (width + height) * 2 * k, height: origin_y + height * k + k };
@@ -240,7 +241,7 @@ fn paint(columns: &[Column], (width, height): (i64, i64), water_top: i32) -> Rgb
             // rectangle it runs down to the floor (a cut-away, like a block diagram).
             let west_below = if i > 0 { surface(i - 1, j) } else { low };
             let south_below = if j + 1 < height { surface(i, j + 1) } else { low };
-            if c.ground >= water_top {
+            if c.ground >= c.water {
                 let light = shade::illumination(
                     clamp(i - 1, j) as f32,
                     clamp(i + 1, j) as f32,
@@ -255,11 +256,11 @@ fn paint(columns: &[Column], (width, height): (i64, i64), water_top: i32) -> Rgb
                 // The sea floor first (seen only through the cut-away faces), then the water.
                 let floor_faces = (west_below.min(c.ground), south_below.min(c.ground));
                 draw_column(&mut img, &p, (i, j), c, c.top, floor_faces);
-                let depth = (water_top - c.ground) as f32;
+                let depth = (c.water - c.ground) as f32;
                 let blue = mix(WATER_DEEP, WATER_SHALLOW, (-depth / 24.0).exp());
                 // Shallow water shows its floor, as clear water does in game.
                 let top = mix(c.top, blue, 1.0 - 0.55 * (-depth / 3.0).exp());
-                draw_water(&mut img, &p, (i, j), water_top, top, c.ground, (west_below, south_below));
+                draw_water(&mut img, &p, (i, j), c.water, top, c.ground, (west_below, south_below));
             }
         }
     }
@@ -352,13 +353,15 @@ mod tests {
     use super::*;
 
     fn land(ground: i32, name: &str) -> Column {
-        Column { ground, top: block_colour(name), filler: block_colour(filler(name)) }
+        // The sea's water top at the default vertical scale, over ground below it.
+        let water = if ground < 62 { 62 } else { i32::MIN };
+        Column { ground, top: block_colour(name), filler: block_colour(filler(name)), water }
     }
 
     #[test]
     fn a_flat_square_fills_its_rhombus_without_gaps() {
         let cols = vec![land(70, "grass_block"); 16 * 16];
-        let img = paint(&cols, (16, 16), 62);
+        let img = paint(&cols, (16, 16));
         let k = (TARGET_WIDTH / 64).clamp(1, 4);
         assert_eq!(img.width() as i64, 32 * 2 * k);
         // The row through the west and east corners of the square's top crosses the tops of
@@ -380,8 +383,8 @@ mod tests {
         // 8×8 flat stone with one snow pillar 20 blocks higher in the middle.
         let mut cols = vec![land(64, "stone"); 64];
         cols[4 * 8 + 4] = land(84, "snow_block");
-        let img = paint(&cols, (8, 8), 62);
-        let flat = paint(&[land(64, "stone"); 64], (8, 8), 62);
+        let img = paint(&cols, (8, 8));
+        let flat = paint(&[land(64, "stone"); 64], (8, 8));
         assert_eq!(img.dimensions().0, flat.dimensions().0);
         let snow = ramp::to_rgb(block_colour("snow_block"));
         let whiteish = |p: &Rgb<u8>| p[0] > 200 && p[1] > 200 && p[2] > 200;
@@ -396,12 +399,23 @@ mod tests {
     }
 
     #[test]
+    fn a_river_above_the_sea_is_drawn_as_water() {
+        let mut cols = vec![land(70, "grass_block"); 8 * 8];
+        for c in cols.iter_mut().skip(3 * 8).take(8) {
+            *c = Column { water: 70, ..land(68, "gravel") };
+        }
+        let img = paint(&cols, (8, 8));
+        let blue = img.pixels().filter(|p| p[2] as i32 > p[0] as i32 + 60 && p[2] as i32 > p[1] as i32 + 30).count();
+        assert!(blue > 20, "only {blue} blue pixels for a river");
+    }
+
+    #[test]
     fn sea_columns_are_blue_and_deep_water_is_darker() {
         let mut cols = vec![land(40, "gravel"); 8 * 8];
         for c in cols.iter_mut().take(8) {
             *c = land(61, "sand"); // a shallow northern row
         }
-        let img = paint(&cols, (8, 8), 62);
+        let img = paint(&cols, (8, 8));
         let blue = img.pixels().filter(|p| p[2] as i32 > p[0] as i32 + 60 && p[2] as i32 > p[1] as i32 + 30).count();
         assert!(blue > img.pixels().count() / 10, "only {blue} blue pixels");
     }
