@@ -222,11 +222,11 @@ pub fn drain(input: &Inputs) -> Drainage {
             discharge[m] += discharge[c];
         }
     }
-    for i in 0..n {
+    for (i, k) in kind.iter_mut().enumerate() {
         match lake.get(i).copied().filter(|&l| l != NONE) {
             // Every cell of a dry basin is its bed: water reaching it ends there.
-            Some(l) if !wet[l] => kind[i] = Kind::Dry,
-            Some(_) if deep(i) => kind[i] = Kind::Lake,
+            Some(l) if !wet[l] => *k = Kind::Dry,
+            Some(_) if deep(i) => *k = Kind::Lake,
             _ => {}
         }
     }
