@@ -34,9 +34,10 @@ pub struct WaterStats {
     /// River length (km) of cells with at least [`RIVER_DISCHARGE`] (the rivers drawn in
     /// the world).
     pub river_km_drawn: f64,
-    /// Of the drawn river length: km ending in the sea, in a lake, in a dry basin, and
-    /// followed [`FOLLOW_CELLS`] past the region without an end.
-    pub ends_km: [f64; 4],
+    /// Of the drawn river length: km ending in the sea, in a lake, in a dry basin, leaving
+    /// the followed window ([`FOLLOW_CELLS`] past the region) without an end, and ending
+    /// nowhere (a dead end on land or a loop: a defect).
+    pub ends_km: [f64; 5],
     /// Area of land cells draining to the sea (km²) and to an inland sink (lake without
     /// outlet or dry basin).
     pub drains_to_sea_km2: f64,
@@ -92,7 +93,8 @@ fn network_stats(pipeline: &Pipeline, area: Rect, s: &mut WaterStats) {
         (d != NO_DOWN).then(|| (y + D8[d as usize].0, x + D8[d as usize].1))
     };
     let inside = |y: i64, x: i64| y >= window.y0 && y < window.y1() && x >= window.x0 && x < window.x1();
-    // Where each cell's water ends: 0 sea, 1 lake, 2 dry basin, 3 not found.
+    // Where each cell's water ends: 0 sea, 1 lake, 2 dry basin, 3 beyond the window, 4 nowhere
+    // (a dead end on land, or a loop).
     let end_of = |mut y: i64, mut x: i64| -> usize {
         for _ in 0..(4 * FOLLOW_CELLS) {
             match kind(y, x) {
@@ -103,10 +105,11 @@ fn network_stats(pipeline: &Pipeline, area: Rect, s: &mut WaterStats) {
             }
             match down(y, x) {
                 Some((ny, nx)) if inside(ny, nx) => (y, x) = (ny, nx),
-                _ => return 3,
+                Some(_) => return 3,
+                None => return 4,
             }
         }
-        3
+        4
     };
     // Where a lake's water finally goes (through its outlet, if it has one).
     let final_end = |y: i64, x: i64| -> usize {
@@ -174,8 +177,9 @@ impl WaterStats {
         (self.river_km_01 * per, self.river_km_drawn * per)
     }
 
-    /// Shares (%) of drawn river length ending in the sea, a lake, a dry basin, nowhere found.
-    pub fn ends_pct(&self) -> [f64; 4] {
+    /// Shares (%) of drawn river length ending in the sea, a lake, a dry basin, beyond the
+    /// window, nowhere.
+    pub fn ends_pct(&self) -> [f64; 5] {
         self.ends_km.map(|k| 100.0 * k / self.river_km_drawn.max(1e-9))
     }
 

@@ -135,5 +135,60 @@ impl Basins {
     }
 }
 
+/// The network with its tiles joined. Each tile is drained in its own window, so where a
+/// river crosses a tile border the two windows may disagree on the filled levels by a little,
+/// and a link that falls in one window can rise in the other — enough, at a flat border, for
+/// water to go round in a loop. Here every link that crosses a tile border must fall in the
+/// levels each cell's own tile gives; one that does not is sent to the lowest neighbour
+/// below the cell instead, and a cell with none (a pit where the two windows meet) becomes a
+/// one-cell lake, the water's end. Levels then strictly fall along every path, so every path
+/// ends (in the sea, a lake or a dry basin) and no river runs uphill. A pure function of the
+/// 3×3 neighbourhood of each cell, so still the same answer for any query.
+pub struct Stitched {
+    /// The per-tile network ([`Basins`] behind the engine's cache).
+    pub basins: Arc<dyn Source>,
+}
+
+impl Source for Stitched {
+    fn channels(&self) -> usize {
+        grid::COUNT
+    }
+
+    fn query(&self, rect: Rect) -> Tile {
+        let t = self.basins.query(rect.pad(1));
+        let mut out = t.crop(rect);
+        let tile = |y: i64, x: i64| (y.div_euclid(TILE), x.div_euclid(TILE));
+        let n = rect.area();
+        for y in rect.y0..rect.y1() {
+            for x in rect.x0..rect.x1() {
+                let code = t.get(grid::DOWN, y, x) as i8;
+                if code == drainage::NO_DOWN {
+                    continue;
+                }
+                let (dy, dx) = drainage::D8[code as usize];
+                let own = t.get(grid::LEVEL, y, x);
+                if tile(y, x) == tile(y + dy, x + dx) || t.get(grid::LEVEL, y + dy, x + dx) < own {
+                    continue;
+                }
+                let lower = drainage::D8
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &(ny, nx))| (k, t.get(grid::LEVEL, y + ny, x + nx)))
+                    .filter(|&(_, level)| level < own)
+                    .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+                let i = ((y - rect.y0) * rect.w + (x - rect.x0)) as usize;
+                match lower {
+                    Some((k, _)) => out.data[grid::DOWN * n + i] = k as f32,
+                    None => {
+                        out.data[grid::DOWN * n + i] = f32::from(drainage::NO_DOWN);
+                        out.data[grid::KIND * n + i] = Kind::Lake as u8 as f32;
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests;

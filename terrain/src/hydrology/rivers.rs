@@ -275,6 +275,13 @@ impl Rivers {
         (lo, hi, Rect::new(y0, x0, cell(hi.1 + reach) - y0 + 1, cell(hi.0 + reach) - x0 + 1))
     }
 
+    /// Evaluates the network cells [`Rivers::columns`] over `blocks` will read, so that a
+    /// later query inside finds them cached.
+    pub fn prefetch(&self, blocks: Rect, block_m: f64) {
+        let (_, _, nodes) = self.around(blocks, block_m);
+        self.network(nodes.pad(1));
+    }
+
     /// The water of every block column of `blocks` (blocks of `block_m` metres, `vertical_m`
     /// metres of height per block), cutting river channels and valleys into `elevation`
     /// (metres, row-major over `blocks`).

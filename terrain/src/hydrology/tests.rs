@@ -76,6 +76,46 @@ fn every_river_runs_downhill_across_tiles_into_the_sea_a_lake_or_a_dry_basin() {
 }
 
 #[test]
+fn no_river_goes_round_in_a_loop_where_tiles_meet() {
+    // Seed 1 at 40 m per block: before the tiles were stitched, 320 river cells here drained
+    // into a loop across the border between tile rows −1 and 0 near x 281–285.
+    let p = Pipeline::new(1, &TerrainSettings { metres_per_block: 40.0, ..TerrainSettings::default() });
+    let area = Rect::new(-16, 264, 32, 48);
+    let all = area.pad(2 * TILE);
+    let t = p.network(all);
+    let mut rivers = 0;
+    for y in area.y0..area.y1() {
+        for x in area.x0..area.x1() {
+            if Kind::from_code(t.get(grid::KIND, y, x)) != Kind::Land || t.get(grid::DISCHARGE, y, x) < RIVER_DISCHARGE
+            {
+                continue;
+            }
+            rivers += 1;
+            let mut c = (y, x);
+            let mut seen = std::collections::HashSet::from([c]);
+            while Kind::from_code(t.get(grid::KIND, c.0, c.1)) == Kind::Land {
+                let Some(d) = downstream(&t, c.0, c.1) else { panic!("river from ({y}, {x}) ends on land at {c:?}") };
+                if !all.contains_rect(&Rect::new(d.0, d.1, 1, 1)) {
+                    break;
+                }
+                let (here, there) = (t.get(grid::LEVEL, c.0, c.1), t.get(grid::LEVEL, d.0, d.1));
+                // Never up; strictly down where a link crosses tiles (within a tile the
+                // priority flood's order already rules out loops).
+                let crosses =
+                    (c.0.div_euclid(TILE), c.1.div_euclid(TILE)) != (d.0.div_euclid(TILE), d.1.div_euclid(TILE));
+                assert!(
+                    there < here || (!crosses && there <= here),
+                    "the level rises from {c:?} ({here}) to {d:?} ({there})"
+                );
+                assert!(seen.insert(d), "river from ({y}, {x}) loops at {d:?}");
+                c = d;
+            }
+        }
+    }
+    assert!(rivers > 20, "only {rivers} river cells");
+}
+
+#[test]
 fn the_network_is_the_same_whatever_the_query() {
     let p = pipeline();
     let whole = p.network(Rect::new(-40, -40, 80, 80));

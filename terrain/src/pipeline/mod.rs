@@ -20,7 +20,7 @@ pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
-use crate::hydrology::{Basins, Rivers, WaterColumns};
+use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
@@ -149,7 +149,7 @@ pub struct Pipeline {
     coarse_elevation: Arc<dyn Source>,
     coarse_sketch: Arc<dyn Source>,
     precipitation: Arc<Windowed>,
-    network: Arc<Windowed>,
+    network: Arc<dyn Source>,
     rivers: Rivers,
 }
 
@@ -218,13 +218,14 @@ impl Pipeline {
             temperature_offset_c: settings.climate.temperature_offset_c as f32,
             lapse_c_per_km: settings.climate.lapse_rate_c_per_km as f32,
         };
-        let network = Windowed::new(
+        let basins = Windowed::new(
             &engine,
             Basins {
                 fine: Arc::new(inputs(base.source.clone(), base.metres)),
                 coarse: Arc::new(inputs(coarse_elevation.clone(), coarse_metres)),
             },
         );
+        let network: Arc<dyn Source> = Arc::new(Stitched { basins });
         let rivers = Rivers::new(network.clone(), seed);
         let finest = Finest::new(base.source, base.metres, settings.model_pixel_metres(), erosion);
         Ok(Pipeline {
@@ -433,6 +434,8 @@ impl Pipeline {
     pub fn prefetch(&self, blocks: Rect) {
         if !self.learned_stages().is_empty() {
             self.model(Pipeline::model_rect(&blocks));
+            // The drainage network under the region reads the learned relief too.
+            self.rivers.prefetch(blocks, self.block_metres());
         }
     }
 
