@@ -141,9 +141,12 @@ fn model_cover(pipeline: &Pipeline, r: Rect) -> Tile {
         for x in r.x0..r.x1() {
             let kind = Kind::from_code(network.get(hydrology::grid::KIND, cell(y), cell(x)));
             // As the blocks show them: ground under the basin's level.
-            let under = elevation.data[i] < network.get(hydrology::grid::LEVEL, cell(y), cell(x));
+            let level = network.get(hydrology::grid::LEVEL, cell(y), cell(x));
+            let under = elevation.data[i] < level;
+            let bed = f64::from(elevation.data[i]) + hydrology::DRY_BED_DEPTH_M < f64::from(level);
             out.data[n + i] = match kind {
-                Kind::Lake | Kind::Dry if under => kind as u8 as f32,
+                Kind::Lake if under => kind as u8 as f32,
+                Kind::Dry if bed => kind as u8 as f32,
                 _ => 0.0,
             };
             i += 1;

@@ -26,7 +26,7 @@ use std::sync::Arc;
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::tile::{Rect, Tile};
 pub use drainage::Kind;
-pub use rivers::{water_width_m, Course, Rivers, WaterColumns, RIVER_DISCHARGE};
+pub use rivers::{water_width_m, Course, Rivers, WaterColumns, DRY_BED_DEPTH_M, RIVER_DISCHARGE};
 
 /// Size of a cell of the drainage network, metres.
 pub const CELL_METRES: f64 = 1000.0;

@@ -31,6 +31,10 @@ const VALLEY_SLOPE: f64 = 0.2;
 /// How far beyond its floodplain a river's valley reaches, metres; past it the relief is
 /// untouched.
 const VALLEY_REACH_M: f64 = 640.0;
+/// How far under a dry basin's spill level the ground must lie to be its bed (salt or clay
+/// flat), metres: the depth that makes a wet basin a lake
+/// ([`super::drainage::LAKE_MIN_DEPTH_M`]).
+pub const DRY_BED_DEPTH_M: f64 = super::drainage::LAKE_MIN_DEPTH_M as f64;
 /// Interpolated basin indicator from which a basin's water fills all ground under its level.
 const SHORE_FULL: f64 = 0.6;
 /// Interpolated basin indicator below which there is no basin water.
@@ -376,7 +380,11 @@ impl Rivers {
         let (_, y, x) = best?;
         let level = cells.level(y, x);
         let rise = SHORE_RISE_M * ((SHORE_FULL - indicator) / (SHORE_FULL - SHORE_EDGE)).max(0.0);
-        (indicator > SHORE_EDGE && e + rise < level).then(|| (cells.kind(y, x), level, cells.discharge(y, x)))
+        let kind = cells.kind(y, x);
+        // A dry basin's bed is its floor, where runoff would pool: the ground at least
+        // DRY_BED_DEPTH_M under the basin's spill level; its shallower slopes stay land.
+        let floor = if kind == Kind::Dry { DRY_BED_DEPTH_M } else { 0.0 };
+        (indicator > SHORE_EDGE && e + rise + floor < level).then(|| (kind, level, cells.discharge(y, x)))
     }
 }
 
