@@ -25,7 +25,7 @@ pub fn cell_centre_y(y: i32) -> i32 {
 }
 
 /// Conditions of the cell whose sample column is (`x`, `z`) (which with its four neighbours
-/// must lie in `columns`) and whose centre is block `centre_y`.
+/// and the rest of its cell must lie in `columns`) and whose centre is block `centre_y`.
 pub fn conditions(
     columns: &Columns,
     vertical: &Vertical,
@@ -34,26 +34,46 @@ pub fn conditions(
     z: i64,
     centre_y: i32,
 ) -> Conditions {
-    let surface_m = columns.elevation(x, z);
-    let surface_temperature = columns.get(channel::TEMPERATURE, x, z);
     let ground_top = columns.water_top_y(x, z).unwrap_or(columns.surface_y(x, z));
-    let (elevation_m, temperature_c) = if centre_y <= ground_top {
-        (surface_m, surface_temperature)
-    } else {
-        // The column's temperature is at its surface, or at the sea surface over the sea.
-        let base_m = surface_m.max(0.0);
-        let cell_m = vertical.air_metres(centre_y).max(base_m);
-        (cell_m, surface_temperature - lapse_c_per_km * (cell_m - base_m) / 1000.0)
-    };
+    at_height(&ground_conditions(columns, x, z), ground_top, vertical, lapse_c_per_km, centre_y)
+}
+
+/// Conditions of the cells at or below the ground (or water) of the cell column whose sample
+/// column is (`x`, `z`): what every cell of that column starts from (see [`at_height`]).
+pub fn ground_conditions(columns: &Columns, x: i64, z: i64) -> Conditions {
+    let surface_m = columns.elevation(x, z);
     Conditions {
-        temperature_c,
+        temperature_c: columns.get(channel::TEMPERATURE, x, z),
         seasonality_c: columns.get(channel::SEASONALITY, x, z),
         precipitation_mm: columns.get(channel::PRECIPITATION, x, z),
         variability_pct: columns.get(channel::VARIABILITY, x, z),
-        elevation_m,
+        elevation_m: surface_m,
         surface_m,
         slope_deg: columns.slope_deg(x, z),
         water: water_body(columns, x, z),
+    }
+}
+
+/// The conditions of the cell centred at block `centre_y` of a cell column whose ground (or
+/// water) top is `ground_top` and whose ground cells have `ground`: the same at or below it,
+/// colder by the lapse rate with height above it.
+pub fn at_height(
+    ground: &Conditions,
+    ground_top: i32,
+    vertical: &Vertical,
+    lapse_c_per_km: f32,
+    centre_y: i32,
+) -> Conditions {
+    if centre_y <= ground_top {
+        return *ground;
+    }
+    // The column's temperature is at its surface, or at the sea surface over the sea.
+    let base_m = ground.surface_m.max(0.0);
+    let cell_m = vertical.air_metres(centre_y).max(base_m);
+    Conditions {
+        elevation_m: cell_m,
+        temperature_c: ground.temperature_c - lapse_c_per_km * (cell_m - base_m) / 1000.0,
+        ..*ground
     }
 }
 

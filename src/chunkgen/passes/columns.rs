@@ -38,14 +38,16 @@ fn biomes<'r>(ctx: &ChunkContext<'r>, columns: &Columns) -> Vec<&'r str> {
         for cx in 0..4 {
             let (sx, sz) = cells::sample_column(ctx.x0 / CELL + cx, ctx.z0 / CELL + cz);
             let ground_top = columns.water_top_y(sx, sz).unwrap_or(columns.surface_y(sx, sz));
-            // Every cell at or below the ground shares one set of conditions.
-            let ground = ctx.rules.biome(&cells::conditions(columns, v, lapse, sx, sz, ground_top));
+            // Every cell at or below the ground shares one set of conditions; the cells above
+            // it differ only in height and temperature.
+            let conditions = cells::ground_conditions(columns, sx, sz);
+            let ground = ctx.rules.biome(&conditions);
             for cy in 0..cells_y {
                 let centre = v.min_y + cy as i32 * CELL as i32 + CELL as i32 / 2;
                 names.push(if centre <= ground_top {
                     ground
                 } else {
-                    ctx.rules.biome(&cells::conditions(columns, v, lapse, sx, sz, centre))
+                    ctx.rules.biome(&cells::at_height(&conditions, ground_top, v, lapse, centre))
                 });
             }
         }

@@ -52,15 +52,28 @@ impl Source for Finest {
         let mut i = 0;
         for y in rect.y0..rect.y1() {
             for x in rect.x0..rect.x1() {
-                let gradient = ((e(y, x + 1) - e(y, x - 1)) / (2.0 * g), (e(y + 1, x) - e(y - 1, x)) / (2.0 * g));
-                let slope = gradient.0.hypot(gradient.1);
-                let (xm, zm) = ((x as f64 + 0.5) * g, (y as f64 + 0.5) * g);
-                let carved = self.erosion.apply(xm, zm, slope, gradient, self.octaves.clone());
-                out.data[i] = (e(y, x) + carved.height) as f32;
+                let (elevation, slope) = carve_cell(&self.erosion, &e, g, (y, x), self.octaves.clone());
+                out.data[i] = elevation as f32;
                 out.data[n + i] = slope as f32;
                 i += 1;
             }
         }
         out
     }
+}
+
+/// The erosion filter's `octaves` carved into cell (`y`, `x`) of a grid of `g`-metre cells
+/// whose elevation (metres) `e` gives, with the slope (m/m) from central differences over its
+/// neighbours: (carved elevation, slope). Shared by every grid the filter is carved on.
+pub(super) fn carve_cell(
+    erosion: &ErosionFilter,
+    e: &impl Fn(i64, i64) -> f64,
+    g: f64,
+    (y, x): (i64, i64),
+    octaves: std::ops::Range<u32>,
+) -> (f64, f64) {
+    let gradient = ((e(y, x + 1) - e(y, x - 1)) / (2.0 * g), (e(y + 1, x) - e(y - 1, x)) / (2.0 * g));
+    let slope = gradient.0.hypot(gradient.1);
+    let (xm, zm) = ((x as f64 + 0.5) * g, (y as f64 + 0.5) * g);
+    (e(y, x) + erosion.apply(xm, zm, slope, gradient, octaves).height, slope)
 }

@@ -14,6 +14,7 @@ use crate::layout::sketch;
 use crate::resample;
 use crate::tile::{Rect, Tile};
 
+use super::finest::carve_cell;
 use super::COARSE_METRES;
 
 /// The network's inputs ([`input`] channels).
@@ -71,11 +72,7 @@ impl Source for NetworkInputs {
         let mut i = 0;
         for y in rect.y0..rect.y1() {
             for x in rect.x0..rect.x1() {
-                let gradient = ((e(y, x + 1) - e(y, x - 1)) / (2.0 * g), (e(y + 1, x) - e(y - 1, x)) / (2.0 * g));
-                let slope = gradient.0.hypot(gradient.1);
-                let (xm, zm) = ((x as f64 + 0.5) * g, (y as f64 + 0.5) * g);
-                let carved = self.erosion.apply(xm, zm, slope, gradient, octaves.clone());
-                let elevation = (e(y, x) + carved.height) as f32;
+                let elevation = carve_cell(&self.erosion, &e, g, (y, x), octaves.clone()).0 as f32;
                 out.data[input::ELEVATION * n + i] = elevation;
                 out.data[input::PRECIPITATION * n + i] = rain.channel(precipitation::ANNUAL_MM)[i];
                 let t0 = climate.channel(sketch::SEA_LEVEL_TEMPERATURE)[i] + self.temperature_offset_c;
