@@ -68,6 +68,10 @@ pub struct Inputs<'a> {
     pub precipitation: &'a [f32],
     /// Annual mean temperature, °C.
     pub temperature: &'a [f32],
+    /// Metres the water must rise at each cell of the window's edge before it leaves there
+    /// (row-major like the rest; only edge cells are read): where the continent's own
+    /// drainage says the window's edge lies in a closed basin, the edge is no free outlet.
+    pub edge_rise: Option<&'a [f32]>,
 }
 
 /// The drainage of a window, row-major like its inputs.
@@ -81,6 +85,9 @@ pub struct Drainage {
     pub level: Vec<f32>,
     /// What each cell is.
     pub kind: Vec<Kind>,
+    /// The filled surface, metres: the elevation, raised over depressions and flats to
+    /// [`EPSILON_M`] above the cell it drains to, so it strictly falls along every path.
+    pub filled: Vec<f32>,
 }
 
 /// Potential evapotranspiration, mm/yr, at a mean temperature (a Thornthwaite-like ramp:
@@ -124,17 +131,33 @@ impl PartialOrd for Wet {
     }
 }
 
-/// Drains a window. The sea and the window's edge are the outlets; every other cell drains
-/// to one of them or into a dry lake bed.
-pub fn drain(input: &Inputs) -> Drainage {
-    let (h, w) = (input.h, input.w);
+/// No lake: a cell the flood did not fill.
+const NONE: usize = usize::MAX;
+
+/// A window flooded from its outlets (the sea and the edge).
+struct Flood {
+    /// The filled surface.
+    filled: Vec<f32>,
+    /// Direction codes, as [`Drainage::down`].
+    down: Vec<i8>,
+    /// Sea or land (lakes are decided later, by water balance).
+    kind: Vec<Kind>,
+    /// The depression each filled cell belongs to (the index of the cell the flood entered
+    /// it by), or [`NONE`].
+    lake: Vec<usize>,
+    /// As [`Drainage::level`].
+    level: Vec<f32>,
+    /// Cells in the order the flood reached them: every cell after its downstream neighbour.
+    order: Vec<usize>,
+}
+
+/// The priority flood (Barnes et al. 2014, ε-variant) of a `h` × `w` window of elevations
+/// `e`, its edge cells raised by `edge_rise`.
+fn flood(h: usize, w: usize, e: &[f32], edge_rise: Option<&[f32]>) -> Flood {
     let n = h * w;
-    let e = input.elevation;
     let mut filled = e.to_vec();
     let mut down = vec![NO_DOWN; n];
     let mut kind = vec![Kind::Land; n];
-    // Lake of each filled cell (the index of the cell the flood entered it by) and its level.
-    const NONE: usize = usize::MAX;
     let mut lake = vec![NONE; n];
     let mut level = e.to_vec();
     let mut seen = vec![false; n];
@@ -142,16 +165,24 @@ pub fn drain(input: &Inputs) -> Drainage {
     for i in 0..n {
         let (y, x) = (i / w, i % w);
         let edge = y == 0 || x == 0 || y == h - 1 || x == w - 1;
-        if e[i] < 0.0 || edge {
-            seen[i] = true;
-            if e[i] < 0.0 {
-                kind[i] = Kind::Sea;
-                level[i] = 0.0;
+        if e[i] < 0.0 {
+            kind[i] = Kind::Sea;
+            level[i] = 0.0;
+        } else if edge {
+            // A raised edge cell is the edge of a basin the window only partly holds: it and
+            // what the flood fills from it are one depression at its height.
+            let rise = edge_rise.map_or(0.0, |r| r[i].max(0.0));
+            if rise > 0.0 {
+                filled[i] = e[i] + rise;
+                level[i] = filled[i];
+                lake[i] = i;
             }
-            heap.push(Wet { height: e[i], index: i });
+        } else {
+            continue;
         }
+        seen[i] = true;
+        heap.push(Wet { height: filled[i], index: i });
     }
-    // Cells in the order the flood reached them: every cell after its downstream neighbour.
     let mut order = Vec::with_capacity(n);
     while let Some(Wet { index: c, .. }) = heap.pop() {
         order.push(c);
@@ -183,6 +214,74 @@ pub fn drain(input: &Inputs) -> Drainage {
             heap.push(Wet { height: filled[m], index: m });
         }
     }
+    Flood { filled, down, kind, lake, level, order }
+}
+
+/// Below this a depression is filled, not breached, metres: carving a path back to the
+/// outlet for every pit of a few centimetres would walk whole flats again and again.
+const MIN_BREACH_M: f32 = 0.5;
+
+/// Metres each cell of a `h` × `w` window is lowered when every depression is breached
+/// rather than filled: a channel is cut from its lowest point back through its rim, the way
+/// a lake's outlet erodes until the lake drains. Cells `closed` (a dry basin, as its filled
+/// surface `filled` says) keep their water and are not cut into.
+///
+/// A priority flood on the carved surface (Soille 2004's carving): the flood descends into a
+/// depression as soon as it reaches it, and each cell found below the surface it was reached
+/// from lowers the path it drains by to just under it.
+pub fn breach(h: usize, w: usize, e: &[f32], filled: &[f32], closed: &[bool]) -> Vec<f32> {
+    let n = h * w;
+    let z: Vec<f32> = (0..n).map(|i| if closed[i] { filled[i].max(e[i]) } else { e[i] }).collect();
+    let mut carved = z.clone();
+    let mut down = vec![NONE; n];
+    let mut seen = vec![false; n];
+    let mut heap = BinaryHeap::new();
+    for i in 0..n {
+        let (y, x) = (i / w, i % w);
+        if e[i] < 0.0 || y == 0 || x == 0 || y == h - 1 || x == w - 1 {
+            seen[i] = true;
+            heap.push(Wet { height: z[i], index: i });
+        }
+    }
+    while let Some(Wet { index: c, .. }) = heap.pop() {
+        let (cy, cx) = ((c / w) as i64, (c % w) as i64);
+        for &(dy, dx) in &D8 {
+            let (ny, nx) = (cy + dy, cx + dx);
+            if ny < 0 || nx < 0 || ny >= h as i64 || nx >= w as i64 {
+                continue;
+            }
+            let m = ny as usize * w + nx as usize;
+            if seen[m] {
+                continue;
+            }
+            seen[m] = true;
+            down[m] = c;
+            if z[m] > carved[c] {
+                carved[m] = z[m];
+            } else if carved[c] - z[m] < MIN_BREACH_M || closed[m] {
+                carved[m] = carved[c] + EPSILON_M;
+            } else {
+                carved[m] = z[m];
+                let (mut target, mut k) = (z[m] - EPSILON_M, c);
+                while k != NONE && carved[k] > target {
+                    carved[k] = target;
+                    target -= EPSILON_M;
+                    k = down[k];
+                }
+            }
+            heap.push(Wet { height: carved[m], index: m });
+        }
+    }
+    (0..n).map(|i| (e[i] - carved[i]).max(0.0)).collect()
+}
+
+/// Drains a window. The sea and the window's edge are the outlets; every other cell drains
+/// to one of them or into a dry lake bed.
+pub fn drain(input: &Inputs) -> Drainage {
+    let n = input.h * input.w;
+    let w = input.w;
+    let e = input.elevation;
+    let Flood { filled, down, mut kind, lake, level, order } = flood(input.h, w, e, input.edge_rise);
 
     let area = input.cell_m * input.cell_m;
     let runoff: Vec<f64> = (0..n)
@@ -230,7 +329,7 @@ pub fn drain(input: &Inputs) -> Drainage {
             _ => {}
         }
     }
-    Drainage { down, discharge: discharge.into_iter().map(|q| q as f32).collect(), level, kind }
+    Drainage { down, discharge: discharge.into_iter().map(|q| q as f32).collect(), level, kind, filled }
 }
 
 #[cfg(test)]
@@ -246,6 +345,7 @@ mod tests {
             elevation,
             precipitation: &vec![precipitation; n],
             temperature: &vec![10.0; n],
+            edge_rise: None,
         })
     }
 
@@ -295,21 +395,7 @@ mod tests {
 
     #[test]
     fn a_closed_basin_fills_to_its_spill_level_where_wet_and_stays_dry_where_arid() {
-        // A bowl (centre 100 m) inside a rim at 300 m with a notch at 200 m on the east side,
-        // outside the rim a slope down to the window's edge.
-        let (h, w) = (11, 11);
-        let e: Vec<f32> = (0..h * w)
-            .map(|i| {
-                let (y, x) = ((i / w) as i64 - 5, (i % w) as i64 - 5);
-                let r = y.abs().max(x.abs());
-                match r {
-                    0..=2 => 100.0 + 10.0 * r as f32,
-                    3 if y == 0 && x == 3 => 200.0,
-                    3 => 300.0,
-                    _ => 150.0 - 10.0 * r as f32,
-                }
-            })
-            .collect();
+        let (h, w, e) = bowl();
         let wet = run(h, w, &e, 2500.0);
         let centre = 5 * w + 5;
         assert_eq!(wet.kind[centre], Kind::Lake);
@@ -325,6 +411,84 @@ mod tests {
         let dry = run(h, w, &e, 120.0);
         assert_eq!(dry.kind[centre], Kind::Dry);
         assert!(dry.discharge[notch] < dry.discharge[centre] + 1e-6, "nothing leaves a dry basin");
+    }
+
+    /// A bowl (centre 100 m) in a rim at 300 m with a notch at 200 m on the east side; outside
+    /// the rim a slope down to the window's edge.
+    fn bowl() -> (usize, usize, Vec<f32>) {
+        let (h, w) = (11, 11);
+        let e = (0..h * w)
+            .map(|i| {
+                let (y, x) = ((i / w) as i64 - 5, (i % w) as i64 - 5);
+                let r = y.abs().max(x.abs());
+                match r {
+                    0..=2 => 100.0 + 10.0 * r as f32,
+                    3 if y == 0 && x == 3 => 200.0,
+                    3 => 300.0,
+                    _ => 150.0 - 10.0 * r as f32,
+                }
+            })
+            .collect();
+        (h, w, e)
+    }
+
+    #[test]
+    fn a_breached_basin_drains_through_a_cut_in_its_rim_and_a_closed_one_is_not_cut() {
+        let (h, w, e) = bowl();
+        let fill = run(h, w, &e, 2500.0).filled;
+        let lower = breach(h, w, &e, &fill, &vec![false; h * w]);
+        assert!(lower.iter().all(|&l| l >= 0.0));
+        let carved: Vec<f32> = e.iter().zip(&lower).map(|(e, l)| e - l).collect();
+        // The carved surface has no pit: every cell has a lower neighbour or is on the edge.
+        for i in 0..h * w {
+            let (y, x) = ((i / w) as i64, (i % w) as i64);
+            if y == 0 || x == 0 || y == h as i64 - 1 || x == w as i64 - 1 {
+                continue;
+            }
+            let lowest = D8
+                .iter()
+                .map(|&(dy, dx)| carved[((y + dy) * w as i64 + x + dx) as usize])
+                .fold(f32::INFINITY, f32::min);
+            assert!(lowest < carved[i], "pit at ({y}, {x}): {}", carved[i]);
+        }
+        // The cut runs through the notch, down to the bowl's floor; the rest of the rim stands.
+        let notch = 5 * w + 8;
+        assert!(carved[notch] < 100.0, "{}", carved[notch]);
+        assert_eq!(lower[2 * w + 2], 0.0, "the rim's corner is not cut");
+        assert!(lower.iter().filter(|&&l| l > 0.0).count() <= 6, "{lower:?}");
+        // A closed (dry) basin keeps its rim.
+        let closed: Vec<bool> = (0..h * w).map(|i| fill[i] > e[i]).collect();
+        let kept = breach(h, w, &e, &fill, &closed);
+        assert_eq!(kept[notch], 0.0);
+    }
+
+    #[test]
+    fn a_raised_window_edge_holds_the_water_back_as_a_lake() {
+        // A valley falling east to the window's edge: free, it drains out there; with the edge
+        // raised 40 m (the continent says the valley runs into a closed basin), its lower end
+        // is a lake at the raised height.
+        let (h, w) = (7, 12);
+        let e: Vec<f32> = (0..h * w)
+            .map(|i| {
+                let (y, x) = ((i / w) as f32, (i % w) as f32);
+                300.0 - 10.0 * x + 40.0 * (y - 3.0).abs()
+            })
+            .collect();
+        let free = run(h, w, &e, 1500.0);
+        assert!(free.kind.iter().all(|&k| k == Kind::Land));
+        let rise = vec![40.0; h * w];
+        let held = drain(&Inputs {
+            h,
+            w,
+            cell_m: 1000.0,
+            elevation: &e,
+            precipitation: &vec![1500.0; h * w],
+            temperature: &vec![10.0; h * w],
+            edge_rise: Some(&rise),
+        });
+        let end = 3 * w + (w - 2);
+        assert_eq!(held.kind[end], Kind::Lake, "{:?}", held.kind);
+        assert!((held.level[end] - (e[3 * w + w - 1] + 40.0)).abs() < 0.01, "{}", held.level[end]);
     }
 
     #[test]

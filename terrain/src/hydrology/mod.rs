@@ -18,15 +18,19 @@
 //! All pure functions of (seed, settings, position): any order, any thread count, the same
 //! bits.
 
+pub mod continental;
 pub mod drainage;
 mod rivers;
+mod stitch;
 
 use std::sync::Arc;
 
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
+use crate::resample;
 use crate::tile::{Rect, Tile};
 pub use drainage::Kind;
 pub use rivers::{water_width_m, Course, Rivers, WaterColumns, DRY_BED_DEPTH_M, RIVER_DISCHARGE};
+pub use stitch::Stitched;
 
 /// Size of a cell of the drainage network, metres.
 pub const CELL_METRES: f64 = 1000.0;
@@ -46,8 +50,11 @@ pub mod grid {
     pub const LEVEL: usize = 2;
     /// [`super::Kind`] code.
     pub const KIND: usize = 3;
+    /// The filled surface, metres ([`super::drainage::Drainage::filled`]): strictly falls
+    /// along every path.
+    pub const FILLED: usize = 4;
     /// Number of channels.
-    pub const COUNT: usize = 4;
+    pub const COUNT: usize = 5;
 }
 
 /// Channels of the network's inputs, one value per cell.
@@ -76,6 +83,12 @@ pub struct Basins {
     pub fine: Arc<dyn Source>,
     /// The same from the coarse grid: the rest of the margin.
     pub coarse: Arc<dyn Source>,
+    /// The continent's drainage on the coarse grid of `coarse_metres`
+    /// ([`continental::Continental`]): how far water must rise to leave the window's edge,
+    /// and how far a breached basin's outlet cuts the relief down.
+    pub continental: Arc<dyn Source>,
+    /// Cell size of `continental`, metres.
+    pub coarse_metres: f64,
 }
 
 impl WindowFn for Basins {
@@ -116,6 +129,15 @@ impl Basins {
                 }
             }
         }
+        let ratio = CELL_METRES / self.coarse_metres;
+        let continent =
+            resample::bilinear(&self.continental.query(resample::source_rect(&context, ratio, 0)), ratio, context);
+        for (e, cut) in t.data[input::ELEVATION * n..(input::ELEVATION + 1) * n]
+            .iter_mut()
+            .zip(continent.channel(continental::channel::LOWER))
+        {
+            *e -= cut;
+        }
         let d = drainage::drain(&drainage::Inputs {
             h: context.h as usize,
             w: context.w as usize,
@@ -123,6 +145,7 @@ impl Basins {
             elevation: t.channel(input::ELEVATION),
             precipitation: t.channel(input::PRECIPITATION),
             temperature: t.channel(input::TEMPERATURE),
+            edge_rise: Some(continent.channel(continental::channel::RISE)),
         });
         let mut out = Tile::zeros(grid::COUNT, context);
         for i in 0..n {
@@ -130,63 +153,9 @@ impl Basins {
             out.data[grid::DISCHARGE * n + i] = d.discharge[i];
             out.data[grid::LEVEL * n + i] = d.level[i];
             out.data[grid::KIND * n + i] = d.kind[i] as u8 as f32;
+            out.data[grid::FILLED * n + i] = d.filled[i];
         }
         out.crop(rect)
-    }
-}
-
-/// The network with its tiles joined. Each tile is drained in its own window, so where a
-/// river crosses a tile border the two windows may disagree on the filled levels by a little,
-/// and a link that falls in one window can rise in the other — enough, at a flat border, for
-/// water to go round in a loop. Here every link that crosses a tile border must fall in the
-/// levels each cell's own tile gives; one that does not is sent to the lowest neighbour
-/// below the cell instead, and a cell with none (a pit where the two windows meet) becomes a
-/// one-cell lake, the water's end. Levels then strictly fall along every path, so every path
-/// ends (in the sea, a lake or a dry basin) and no river runs uphill. A pure function of the
-/// 3×3 neighbourhood of each cell, so still the same answer for any query.
-pub struct Stitched {
-    /// The per-tile network ([`Basins`] behind the engine's cache).
-    pub basins: Arc<dyn Source>,
-}
-
-impl Source for Stitched {
-    fn channels(&self) -> usize {
-        grid::COUNT
-    }
-
-    fn query(&self, rect: Rect) -> Tile {
-        let t = self.basins.query(rect.pad(1));
-        let mut out = t.crop(rect);
-        let tile = |y: i64, x: i64| (y.div_euclid(TILE), x.div_euclid(TILE));
-        let n = rect.area();
-        for y in rect.y0..rect.y1() {
-            for x in rect.x0..rect.x1() {
-                let code = t.get(grid::DOWN, y, x) as i8;
-                if code == drainage::NO_DOWN {
-                    continue;
-                }
-                let (dy, dx) = drainage::D8[code as usize];
-                let own = t.get(grid::LEVEL, y, x);
-                if tile(y, x) == tile(y + dy, x + dx) || t.get(grid::LEVEL, y + dy, x + dx) < own {
-                    continue;
-                }
-                let lower = drainage::D8
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &(ny, nx))| (k, t.get(grid::LEVEL, y + ny, x + nx)))
-                    .filter(|&(_, level)| level < own)
-                    .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
-                let i = ((y - rect.y0) * rect.w + (x - rect.x0)) as usize;
-                match lower {
-                    Some((k, _)) => out.data[grid::DOWN * n + i] = k as f32,
-                    None => {
-                        out.data[grid::DOWN * n + i] = f32::from(drainage::NO_DOWN);
-                        out.data[grid::KIND * n + i] = Kind::Lake as u8 as f32;
-                    }
-                }
-            }
-        }
-        out
     }
 }
 

@@ -99,14 +99,11 @@ fn no_river_goes_round_in_a_loop_where_tiles_meet() {
                     break;
                 }
                 let (here, there) = (t.get(grid::LEVEL, c.0, c.1), t.get(grid::LEVEL, d.0, d.1));
-                // Never up; strictly down where a link crosses tiles (within a tile the
-                // priority flood's order already rules out loops).
-                let crosses =
-                    (c.0.div_euclid(TILE), c.1.div_euclid(TILE)) != (d.0.div_euclid(TILE), d.1.div_euclid(TILE));
-                assert!(
-                    there < here || (!crosses && there <= here),
-                    "the level rises from {c:?} ({here}) to {d:?} ({there})"
-                );
+                assert!(there <= here, "the level rises from {c:?} ({here}) to {d:?} ({there})");
+                // The filled surface strictly falls along every link, within a tile (the
+                // priority flood's order) and across tiles (the stitching): no loop can close.
+                let (here, there) = (t.get(grid::FILLED, c.0, c.1), t.get(grid::FILLED, d.0, d.1));
+                assert!(there < here, "the filled surface rises from {c:?} ({here}) to {d:?} ({there})");
                 assert!(seen.insert(d), "river from ({y}, {x}) loops at {d:?}");
                 c = d;
             }

@@ -20,7 +20,8 @@ pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
-use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns};
+use crate::hydrology::continental::Continental;
+use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns, CELL_METRES};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
@@ -209,7 +210,8 @@ impl Pipeline {
         // did), resampled to it, with the erosion filter's octaves the grid can hold.
         let base = ran.pop().unwrap_or_else(|| StageGrid::layout(Arc::new(layout.elevation(BASE_METRES)), BASE_METRES));
         let erosion = ErosionFilter::new(seed);
-        let inputs = |base: Arc<dyn Source>, base_metres: f64| NetworkInputs {
+        let inputs = |base: Arc<dyn Source>, base_metres: f64, cell_metres: f64| NetworkInputs {
+            cell_metres,
             base,
             base_metres,
             erosion,
@@ -221,11 +223,19 @@ impl Pipeline {
         let basins = Windowed::new(
             &engine,
             Basins {
-                fine: Arc::new(inputs(base.source.clone(), base.metres)),
-                coarse: Arc::new(inputs(coarse_elevation.clone(), coarse_metres)),
+                fine: Arc::new(inputs(base.source.clone(), base.metres, CELL_METRES)),
+                coarse: Arc::new(inputs(coarse_elevation.clone(), coarse_metres, CELL_METRES)),
+                continental: Windowed::new(
+                    &engine,
+                    Continental {
+                        inputs: Arc::new(inputs(coarse_elevation.clone(), coarse_metres, coarse_metres)),
+                        cell_metres: coarse_metres,
+                    },
+                ),
+                coarse_metres,
             },
         );
-        let network: Arc<dyn Source> = Arc::new(Stitched { basins });
+        let network: Arc<dyn Source> = Windowed::new(&engine, Stitched { basins });
         let rivers = Rivers::new(network.clone(), seed);
         let finest = Finest::new(base.source, base.metres, settings.model_pixel_metres(), erosion);
         Ok(Pipeline {
