@@ -1,15 +1,17 @@
 //! The aquatic pass: what grows by and in water, once the ground, the water and the land's
 //! plants are in place: seagrass and kelp on sea floors that are not frozen, lily pads on
-//! lakes and slow rivers in mild climates, sugar cane on the banks where ground meets water.
+//! lakes and slow rivers in mild climates, sugar cane on the banks where ground meets water,
+//! mangrove roots in the shallow water of mangrove swamps.
 //!
 //! Like every pass, a pure function of global coordinates: each choice hashes (seed, x, z)
 //! and reads only the column and its four neighbours, which the columns pass provides.
 
-use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
 
 use crate::chunkgen::columns::Water;
 use crate::chunkgen::hash::{hash3, unit3};
 use crate::chunkgen::surface::SEA_ICE_C;
+use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::ChunkContext;
 use crate::terrain::pipeline::channel;
 
@@ -33,16 +35,43 @@ pub const LILY_PAD_MAX_M3S: f32 = 20.0;
 pub const SUGAR_CANE_CHANCE: f32 = 0.2;
 /// The coldest climate sugar cane grows in, °C.
 pub const SUGAR_CANE_MIN_C: f32 = 8.0;
+/// The biome whose shallow water grows mangrove roots.
+pub const MANGROVE_BIOME: &str = "minecraft:mangrove_swamp";
+/// Chance of a clump of mangrove roots on a water column of [`MANGROVE_BIOME`] at most
+/// [`MANGROVE_MAX_DEPTH`] deep.
+pub const MANGROVE_ROOTS_CHANCE: f32 = 0.25;
+/// The deepest water mangrove roots stand in, blocks.
+pub const MANGROVE_MAX_DEPTH: i32 = 3;
 
 /// Places the aquatic plants of every column of the chunk.
 pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
-    let (v, seed, columns) = (*ctx.vertical(), ctx.seed(), ctx.columns());
+    let (v, seed, columns, cells_y) = (*ctx.vertical(), ctx.seed(), ctx.columns(), ctx.cells_y());
     for (lx, lz, x, z) in ctx.each_column() {
         let ground = columns.surface_y(x, z);
         let temperature = columns.get(channel::TEMPERATURE, x, z);
         let roll = unit3(seed, SALT_AQUATIC, x, 0, z);
         let ly = |y: i32| (y - v.min_y) as u32;
         let top = chunk.block_state(lx, ly(ground), lz);
+        let cell = ((lz as i64 / CELL) * 4 + lx as i64 / CELL) as usize;
+        let cell_y = ((cells::cell_centre_y(ground) - v.min_y) / CELL as i32) as usize;
+        let biome = ctx.biomes[cell * cells_y + cell_y.min(cells_y - 1)];
+        if let Some(water_top) = columns.water_top_y(x, z) {
+            let depth = water_top - ground;
+            let rooted = chunk.block_state(lx, ly(ground + 1), lz) == BlockState::WATER;
+            if biome == MANGROVE_BIOME && rooted && depth <= MANGROVE_MAX_DEPTH && roll < MANGROVE_ROOTS_CHANCE {
+                // Roots from the mud to one block over the water, as a mangrove stands on them.
+                let wet = BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True);
+                for y in ground + 1..=water_top {
+                    chunk.set_block_state(lx, ly(y), lz, wet);
+                }
+                if ((water_top + 1) as u32) < (v.min_y + v.height) as u32
+                    && chunk.block_state(lx, ly(water_top + 1), lz).is_air()
+                {
+                    chunk.set_block_state(lx, ly(water_top + 1), lz, BlockState::MANGROVE_ROOTS);
+                }
+                continue;
+            }
+        }
         match (columns.water(x, z), columns.water_top_y(x, z)) {
             (Water::Sea, Some(water_top)) if temperature >= SEA_ICE_C => {
                 let depth = water_top - ground;
@@ -146,6 +175,29 @@ mod tests {
         }
         let (frozen, v) = grow(|_, _| (-200.0, -5.0), "minecraft:frozen_ocean");
         assert_eq!(count(&frozen, &v, BlockState::SEAGRASS) + count(&frozen, &v, BlockState::KELP), 0);
+    }
+
+    #[test]
+    fn mangrove_swamps_grow_roots_in_shallow_water_from_the_bed_to_over_the_surface() {
+        let (swamp, v) = grow(|_, _| (-30.0, 26.0), MANGROVE_BIOME);
+        let roots = count(&swamp, &v, BlockState::MANGROVE_ROOTS);
+        let wet = count(&swamp, &v, BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True));
+        assert!(wet > 20 && roots > 10, "{wet} waterlogged, {roots} over the water");
+        // Every clump stands on the bed, waterlogged up to the surface, and no water is left
+        // open to air beside an unwaterlogged root.
+        for (x, z) in (0..16u32).flat_map(|x| (0..16u32).map(move |z| (x, z))) {
+            for y in 1..v.height as u32 - 1 {
+                if swamp.block_state(x, y, z) == BlockState::MANGROVE_ROOTS {
+                    assert!(swamp.block_state(x, y + 1, z).is_air(), "root under something at ({x}, {y}, {z})");
+                    assert!(swamp.block_state(x, y - 1, z).get(PropName::Waterlogged) == Some(PropValue::True));
+                }
+            }
+        }
+        // Deep water and other biomes grow none.
+        let (deep, v) = grow(|_, _| (-1000.0, 26.0), MANGROVE_BIOME);
+        assert_eq!(count(&deep, &v, BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True)), 0);
+        let (ocean, v) = grow(|_, _| (-30.0, 26.0), "minecraft:warm_ocean");
+        assert_eq!(count(&ocean, &v, BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True)), 0);
     }
 
     #[test]
