@@ -8,10 +8,10 @@
 
 use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
 
+use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::columns::Water;
 use crate::chunkgen::hash::{hash3, unit3};
 use crate::chunkgen::surface::SEA_ICE_C;
-use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::ChunkContext;
 use crate::terrain::pipeline::channel;
 
