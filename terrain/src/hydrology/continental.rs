@@ -17,15 +17,15 @@
 use std::sync::Arc;
 
 use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
-use crate::tile::Tile;
+use crate::tile::{Rect, Tile};
 
-use super::drainage::{breach, drain, Inputs, Kind};
+use super::drainage::{breach, drain, runoff_mm, Inputs, Kind, D8, NO_DOWN, SECONDS_PER_YEAR};
 use super::input;
 
 /// Side of a drained tile, coarse cells.
-pub const TILE: i64 = 16;
+pub const TILE: i64 = 64;
 /// Coarse cells drained around a tile on every side.
-pub const MARGIN: i64 = 64;
+pub const MARGIN: i64 = 128;
 
 /// Channels of the continent's drainage.
 pub mod channel {
@@ -34,8 +34,15 @@ pub mod channel {
     pub const RISE: usize = 0;
     /// How far the cell is cut down by a breached basin's outlet, metres.
     pub const LOWER: usize = 1;
+    /// Direction code of the downstream neighbour on the carved surface
+    /// ([`super::super::drainage::D8`]), or −1.
+    pub const DOWN: usize = 2;
+    /// The carved surface, metres: strictly falls downstream.
+    pub const CARVED: usize = 3;
+    /// Discharge leaving the cell along the carved surface, m³/s.
+    pub const DISCHARGE: usize = 4;
     /// Number of channels.
-    pub const COUNT: usize = 2;
+    pub const COUNT: usize = 5;
 }
 
 /// The continent's drainage as a window function on the coarse grid.
@@ -75,20 +82,161 @@ impl WindowFn for Continental {
                     elevation: e,
                     precipitation: t.channel(input::PRECIPITATION),
                     temperature: t.channel(input::TEMPERATURE),
+                    inflow: None,
                     edge_rise: None,
                 });
                 let closed: Vec<bool> = d.kind.iter().map(|&k| k == Kind::Dry).collect();
-                let lower = breach(h, w, e, &d.filled, &closed);
+                let cut = breach(h, w, e, &d.filled, &closed);
+                // Discharge along the carved surface; a dry basin's water ends in it.
                 let n = h * w;
+                let area = self.cell_metres * self.cell_metres;
+                let mut discharge = vec![0.0f64; n];
+                for &c in cut.order.iter().rev() {
+                    if e[c] >= 0.0 {
+                        let mm = runoff_mm(t.channel(input::PRECIPITATION)[c], t.channel(input::TEMPERATURE)[c]);
+                        discharge[c] += mm / 1000.0 * area / SECONDS_PER_YEAR;
+                    }
+                    if closed[c] || cut.down[c] == NO_DOWN {
+                        continue;
+                    }
+                    let (dy, dx) = D8[cut.down[c] as usize];
+                    let m = ((c / w) as i64 + dy) as usize * w + ((c % w) as i64 + dx) as usize;
+                    discharge[m] += discharge[c];
+                }
                 let mut data = vec![0.0; channel::COUNT * n];
                 for i in 0..n {
                     if closed[i] {
                         data[channel::RISE * n + i] = (d.filled[i] - e[i]).max(0.0);
                     }
-                    data[channel::LOWER * n + i] = lower[i];
+                    data[channel::LOWER * n + i] = cut.lower[i];
+                    data[channel::DOWN * n + i] = if closed[i] { f32::from(NO_DOWN) } else { f32::from(cut.down[i]) };
+                    data[channel::CARVED * n + i] = cut.carved[i];
+                    data[channel::DISCHARGE * n + i] = discharge[i] as f32;
                 }
                 Tile::from_data(channel::COUNT, context, data).crop(rect)
             })
             .collect()
+    }
+}
+
+/// Discharge from which the continent's rivers are burned into the network's relief, m³/s:
+/// trunks some tens of kilometres apart, so that every basin between two of them is
+/// narrower than a network window's margin.
+pub const TRUNK_M3S: f32 = 20.0;
+/// How far under the carved surface a trunk's channel is burned, metres: below the 1 km
+/// relief's own bumps across a lowland, so the channel runs unbroken.
+pub const BURN_DEPTH_M: f32 = 15.0;
+
+/// Burns the continent's trunk rivers into the elevation of `cells` (a window of the network,
+/// row-major) from the continent's drainage `continent` on cells `factor` times larger:
+/// each trunk link, centre to centre, is drawn as a chain of cells whose height falls from
+/// one carved height to the next ([`BURN_DEPTH_M`] under it), the classic stream burning of
+/// hydrology. Every window burns the same chains, so every window sees the same way down to
+/// the sea. Where a trunk enters the window from outside, its discharge is added to
+/// `inflow` at the first cell it burns inside the window's edge, so big rivers carry their whole basin's water.
+pub fn burn(continent: &Tile, factor: i64, cells: Rect, elevation: &mut [f32], inflow: &mut [f32]) {
+    let f = factor as f64;
+    let centre = |cy: i64, cx: i64| ((cy as f64 + 0.5) * f, (cx as f64 + 0.5) * f);
+    let inside = |y: i64, x: i64| y >= cells.y0 && y < cells.y1() && x >= cells.x0 && x < cells.x1();
+    let r = continent.rect;
+    for cy in r.y0..r.y1() {
+        for cx in r.x0..r.x1() {
+            let code = continent.get(channel::DOWN, cy, cx) as i8;
+            let q = continent.get(channel::DISCHARGE, cy, cx);
+            if code == NO_DOWN || q < TRUNK_M3S {
+                continue;
+            }
+            // The continent's own tiles may disagree where they meet, as the network's do:
+            // a link whose carved surface does not fall goes to the lowest neighbour below
+            // instead (the network's stitching rule), or is not burned.
+            let carved =
+                |y: i64, x: i64| r.contains_rect(&Rect::new(y, x, 1, 1)).then(|| continent.get(channel::CARVED, y, x));
+            let ha = continent.get(channel::CARVED, cy, cx);
+            let (dy, dx) = D8[code as usize];
+            let falls = carved(cy + dy, cx + dx).is_some_and(|h| h < ha);
+            let Some(((dy, dx), hb)) = (if falls {
+                Some(((dy, dx), carved(cy + dy, cx + dx).unwrap_or(ha)))
+            } else {
+                D8.iter()
+                    .filter_map(|&(dy, dx)| carved(cy + dy, cx + dx).filter(|&h| h < ha).map(|h| ((dy, dx), h)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+            }) else {
+                continue;
+            };
+            let (ny, nx) = (cy + dy, cx + dx);
+            let (a, b) = (centre(cy, cx), centre(ny, nx));
+            let from_outside = !inside(a.0.floor() as i64, a.1.floor() as i64);
+            let mut entered = false;
+            // Steps of at most half a cell: the chain is 8-connected.
+            let steps = (2.0 * f * if dy != 0 && dx != 0 { std::f64::consts::SQRT_2 } else { 1.0 }).ceil() as i64;
+            for s in 0..=steps {
+                let t = s as f64 / steps as f64;
+                let (y, x) = ((a.0 + t * (b.0 - a.0)).floor() as i64, (a.1 + t * (b.1 - a.1)).floor() as i64);
+                if !inside(y, x) {
+                    continue;
+                }
+                let i = ((y - cells.y0) * cells.w + (x - cells.x0)) as usize;
+                let h = ha + t as f32 * (hb - ha) - BURN_DEPTH_M;
+                elevation[i] = elevation[i].min(h);
+                // Not on the window's edge: those cells are its outlets, water added there
+                // would leave at once.
+                let edge = y == cells.y0 || x == cells.x0 || y == cells.y1() - 1 || x == cells.x1() - 1;
+                if from_outside && !entered && !edge {
+                    inflow[i] += q;
+                    entered = true;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A continent of 4 × 4 coarse cells with one trunk along row 1, west to east, its carved
+    /// surface `carved` at columns 0…3; the link from column 2 rises when `carved[3]` does.
+    fn continent(carved: [f32; 4]) -> Tile {
+        let rect = Rect::new(0, 0, 4, 4);
+        let mut t = Tile::zeros(channel::COUNT, rect);
+        let n = rect.area();
+        for i in 0..n {
+            t.data[channel::DOWN * n + i] = f32::from(NO_DOWN);
+            t.data[channel::CARVED * n + i] = 500.0;
+        }
+        for (x, &h) in carved.iter().enumerate() {
+            let i = 4 + x;
+            t.data[channel::CARVED * n + i] = h;
+            t.data[channel::DISCHARGE * n + i] = 100.0;
+            t.data[channel::DOWN * n + i] = if x < 3 { 4.0 } else { f32::from(NO_DOWN) };
+        }
+        t
+    }
+
+    #[test]
+    fn a_trunk_is_burned_as_an_unbroken_falling_chain_and_brings_its_water_in() {
+        // Fine cells 8 to a coarse one; the window starts east of the trunk's first centre.
+        let cells = Rect::new(0, 8, 32, 24);
+        let mut elevation = vec![100.0; cells.area()];
+        let mut inflow = vec![0.0; cells.area()];
+        burn(&continent([60.0, 50.0, 40.0, 30.0]), 8, cells, &mut elevation, &mut inflow);
+        let at = |y: i64, x: i64| elevation[((y - cells.y0) * cells.w + x - cells.x0) as usize];
+        // Row 12 holds the centres of coarse row 1: burned from the window's edge (x 8) to the
+        // last centre (x 28), falling all the way, 15 m under the carved surface.
+        let chain: Vec<f32> = (8..=28).map(|x| at(12, x)).collect();
+        assert!(chain.windows(2).all(|w| w[1] < w[0]), "{chain:?}");
+        // (A cell takes the lowest sample in it: up to one cell's fall, 1.25 m, under the line.)
+        let under = |h: f32, carved: f32| (0.0..1.3).contains(&(carved - BURN_DEPTH_M - h));
+        assert!(under(at(12, 12), 50.0) && under(at(12, 28), 30.0), "{} {}", at(12, 12), at(12, 28));
+        assert_eq!((at(12, 29), at(11, 20), at(13, 20)), (100.0, 100.0, 100.0), "only the chain is burned");
+        // The trunk enters the window from the west: its water comes in just inside the edge.
+        let i = |y: i64, x: i64| ((y - cells.y0) * cells.w + x - cells.x0) as usize;
+        assert_eq!(inflow[i(12, 9)], 100.0);
+        assert_eq!(inflow.iter().sum::<f32>(), 100.0);
+        // A link whose carved surface rises (two continent tiles disagreeing) is not burned.
+        let mut raised = vec![100.0; cells.area()];
+        burn(&continent([60.0, 50.0, 40.0, 45.0]), 8, cells, &mut raised, &mut vec![0.0; cells.area()]);
+        let at = |y: i64, x: i64| raised[i(y, x)];
+        assert!(at(12, 18) < 100.0 && at(12, 24) == 100.0, "{} {}", at(12, 18), at(12, 24));
     }
 }

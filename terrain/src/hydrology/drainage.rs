@@ -26,7 +26,7 @@ const EPSILON_M: f32 = 1e-3;
 /// the default vertical scale: a shallower basin would be at most one block deep.
 pub const LAKE_MIN_DEPTH_M: f32 = 25.0;
 /// Seconds in a year (discharge is m³/s, climate mm/yr).
-const SECONDS_PER_YEAR: f64 = 365.25 * 86_400.0;
+pub const SECONDS_PER_YEAR: f64 = 365.25 * 86_400.0;
 
 /// What a cell is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,6 +68,9 @@ pub struct Inputs<'a> {
     pub precipitation: &'a [f32],
     /// Annual mean temperature, °C.
     pub temperature: &'a [f32],
+    /// Water flowing in at each cell from beyond the window, m³/s (a river the continent's
+    /// drainage brings in), added to the cell's own runoff.
+    pub inflow: Option<&'a [f32]>,
     /// Metres the water must rise at each cell of the window's edge before it leaves there
     /// (row-major like the rest; only edge cells are read): where the continent's own
     /// drainage says the window's edge lies in a closed basin, the edge is no free outlet.
@@ -217,6 +220,26 @@ fn flood(h: usize, w: usize, e: &[f32], edge_rise: Option<&[f32]>) -> Flood {
     Flood { filled, down, kind, lake, level, order }
 }
 
+/// A window with its depressions breached ([`breach`]).
+pub struct Breach {
+    /// Metres each cell is cut down.
+    pub lower: Vec<f32>,
+    /// The carved surface, metres: strictly falls along `down` (a closed basin's cells stand
+    /// at its filled surface).
+    pub carved: Vec<f32>,
+    /// Direction code of each cell's downstream neighbour on the carved surface, or
+    /// [`NO_DOWN`].
+    pub down: Vec<i8>,
+    /// Cells in the order the flood reached them: every cell after its downstream neighbour.
+    pub order: Vec<usize>,
+}
+
+/// Least fall of the carved surface from a cell to the next downstream, metres: a river cut
+/// through a basin's rim, or run across a flat, keeps a slope the finer grids resolve (at
+/// [`EPSILON_M`] per coarse cell a trunk river burned into the network lay flat for tens of
+/// kilometres, and windows draining it from different ends disagreed on its direction).
+const BREACH_FALL_M: f32 = 0.1;
+
 /// Below this a depression is filled, not breached, metres: carving a path back to the
 /// outlet for every pit of a few centimetres would walk whole flats again and again.
 const MIN_BREACH_M: f32 = 0.5;
@@ -228,12 +251,15 @@ const MIN_BREACH_M: f32 = 0.5;
 ///
 /// A priority flood on the carved surface (Soille 2004's carving): the flood descends into a
 /// depression as soon as it reaches it, and each cell found below the surface it was reached
-/// from lowers the path it drains by to just under it.
-pub fn breach(h: usize, w: usize, e: &[f32], filled: &[f32], closed: &[bool]) -> Vec<f32> {
+/// from lowers the path it drains by to just under it. The carved surface falls at least
+/// [`BREACH_FALL_M`] a cell along every path (raised over flats where it must).
+pub fn breach(h: usize, w: usize, e: &[f32], filled: &[f32], closed: &[bool]) -> Breach {
     let n = h * w;
     let z: Vec<f32> = (0..n).map(|i| if closed[i] { filled[i].max(e[i]) } else { e[i] }).collect();
     let mut carved = z.clone();
     let mut down = vec![NONE; n];
+    let mut code = vec![NO_DOWN; n];
+    let mut order = Vec::with_capacity(n);
     let mut seen = vec![false; n];
     let mut heap = BinaryHeap::new();
     for i in 0..n {
@@ -244,8 +270,9 @@ pub fn breach(h: usize, w: usize, e: &[f32], filled: &[f32], closed: &[bool]) ->
         }
     }
     while let Some(Wet { index: c, .. }) = heap.pop() {
+        order.push(c);
         let (cy, cx) = ((c / w) as i64, (c % w) as i64);
-        for &(dy, dx) in &D8 {
+        for (d, &(dy, dx)) in D8.iter().enumerate() {
             let (ny, nx) = (cy + dy, cx + dx);
             if ny < 0 || nx < 0 || ny >= h as i64 || nx >= w as i64 {
                 continue;
@@ -256,23 +283,25 @@ pub fn breach(h: usize, w: usize, e: &[f32], filled: &[f32], closed: &[bool]) ->
             }
             seen[m] = true;
             down[m] = c;
-            if z[m] > carved[c] {
+            code[m] = (7 - d) as i8;
+            if z[m] >= carved[c] + BREACH_FALL_M {
                 carved[m] = z[m];
             } else if carved[c] - z[m] < MIN_BREACH_M || closed[m] {
-                carved[m] = carved[c] + EPSILON_M;
+                carved[m] = carved[c] + BREACH_FALL_M;
             } else {
                 carved[m] = z[m];
-                let (mut target, mut k) = (z[m] - EPSILON_M, c);
+                let (mut target, mut k) = (z[m] - BREACH_FALL_M, c);
                 while k != NONE && carved[k] > target {
                     carved[k] = target;
-                    target -= EPSILON_M;
+                    target -= BREACH_FALL_M;
                     k = down[k];
                 }
             }
             heap.push(Wet { height: carved[m], index: m });
         }
     }
-    (0..n).map(|i| (e[i] - carved[i]).max(0.0)).collect()
+    let lower = (0..n).map(|i| (e[i] - carved[i]).max(0.0)).collect();
+    Breach { lower, carved, down: code, order }
 }
 
 /// Drains a window. The sea and the window's edge are the outlets; every other cell drains
@@ -290,6 +319,7 @@ pub fn drain(input: &Inputs) -> Drainage {
                 0.0
             } else {
                 runoff_mm(input.precipitation[i], input.temperature[i]) / 1000.0 * area / SECONDS_PER_YEAR
+                    + input.inflow.map_or(0.0, |q| f64::from(q[i]))
             }
         })
         .collect();
@@ -345,6 +375,7 @@ mod tests {
             elevation,
             precipitation: &vec![precipitation; n],
             temperature: &vec![10.0; n],
+            inflow: None,
             edge_rise: None,
         })
     }
@@ -436,7 +467,7 @@ mod tests {
     fn a_breached_basin_drains_through_a_cut_in_its_rim_and_a_closed_one_is_not_cut() {
         let (h, w, e) = bowl();
         let fill = run(h, w, &e, 2500.0).filled;
-        let lower = breach(h, w, &e, &fill, &vec![false; h * w]);
+        let lower = breach(h, w, &e, &fill, &vec![false; h * w]).lower;
         assert!(lower.iter().all(|&l| l >= 0.0));
         let carved: Vec<f32> = e.iter().zip(&lower).map(|(e, l)| e - l).collect();
         // The carved surface has no pit: every cell has a lower neighbour or is on the edge.
@@ -458,7 +489,7 @@ mod tests {
         assert!(lower.iter().filter(|&&l| l > 0.0).count() <= 6, "{lower:?}");
         // A closed (dry) basin keeps its rim.
         let closed: Vec<bool> = (0..h * w).map(|i| fill[i] > e[i]).collect();
-        let kept = breach(h, w, &e, &fill, &closed);
+        let kept = breach(h, w, &e, &fill, &closed).lower;
         assert_eq!(kept[notch], 0.0);
     }
 
@@ -484,6 +515,7 @@ mod tests {
             elevation: &e,
             precipitation: &vec![1500.0; h * w],
             temperature: &vec![10.0; h * w],
+            inflow: None,
             edge_rise: Some(&rise),
         });
         let end = 3 * w + (w - 2);

@@ -138,6 +138,18 @@ impl Basins {
         {
             *e -= cut;
         }
+        // The continent's trunk rivers, burned in: from the coarse cells whose links can
+        // cross the window.
+        let factor = (self.coarse_metres / CELL_METRES).round() as i64;
+        let trunks = self.continental.query(resample::source_rect(&context, ratio, 0).pad(1));
+        let mut inflow = vec![0.0; n];
+        continental::burn(
+            &trunks,
+            factor,
+            context,
+            &mut t.data[input::ELEVATION * n..(input::ELEVATION + 1) * n],
+            &mut inflow,
+        );
         let d = drainage::drain(&drainage::Inputs {
             h: context.h as usize,
             w: context.w as usize,
@@ -145,6 +157,7 @@ impl Basins {
             elevation: t.channel(input::ELEVATION),
             precipitation: t.channel(input::PRECIPITATION),
             temperature: t.channel(input::TEMPERATURE),
+            inflow: Some(&inflow),
             edge_rise: Some(continent.channel(continental::channel::RISE)),
         });
         let mut out = Tile::zeros(grid::COUNT, context);

@@ -150,6 +150,7 @@ pub struct Pipeline {
     coarse_elevation: Arc<dyn Source>,
     coarse_sketch: Arc<dyn Source>,
     precipitation: Arc<Windowed>,
+    continental: Arc<dyn Source>,
     network: Arc<dyn Source>,
     rivers: Rivers,
 }
@@ -220,18 +221,19 @@ impl Pipeline {
             temperature_offset_c: settings.climate.temperature_offset_c as f32,
             lapse_c_per_km: settings.climate.lapse_rate_c_per_km as f32,
         };
+        let continental: Arc<dyn Source> = Windowed::new(
+            &engine,
+            Continental {
+                inputs: Arc::new(inputs(coarse_elevation.clone(), coarse_metres, coarse_metres)),
+                cell_metres: coarse_metres,
+            },
+        );
         let basins = Windowed::new(
             &engine,
             Basins {
                 fine: Arc::new(inputs(base.source.clone(), base.metres, CELL_METRES)),
                 coarse: Arc::new(inputs(coarse_elevation.clone(), coarse_metres, CELL_METRES)),
-                continental: Windowed::new(
-                    &engine,
-                    Continental {
-                        inputs: Arc::new(inputs(coarse_elevation.clone(), coarse_metres, coarse_metres)),
-                        cell_metres: coarse_metres,
-                    },
-                ),
+                continental: continental.clone(),
                 coarse_metres,
             },
         );
@@ -248,6 +250,7 @@ impl Pipeline {
             coarse_elevation,
             coarse_sketch,
             precipitation,
+            continental,
             network,
             rivers,
         })
@@ -365,6 +368,12 @@ impl Pipeline {
     /// The courses of the rivers near `blocks`, for maps.
     pub fn river_courses(&self, blocks: Rect) -> Vec<crate::hydrology::Course> {
         self.rivers.courses(blocks, self.block_metres())
+    }
+
+    /// The continent's drainage over `cells` of the coarse grid
+    /// ([`crate::hydrology::continental::channel`]).
+    pub fn continent(&self, cells: Rect) -> Tile {
+        self.continental.query(cells)
     }
 
     /// The drainage network over `cells` (cells of [`crate::hydrology::CELL_METRES`]), with
