@@ -146,7 +146,7 @@ pub fn water(config: &Config, sources: &Sources, a: &WaterArgs) -> Result<(), Fa
     println!("| drawn river length ending in the sea, % | {:.1} |", ends[0]);
     println!("| … in a lake, % | {:.1} |", ends[1]);
     println!("| … in a dry basin, % | {:.1} |", ends[2]);
-    println!("| … leaving the region by more than 400 km before it ends, % | {:.1} |", ends[3]);
+    println!("| … leaving by more than 400 km with no end down the continent's rivers, % | {:.1} |", ends[3]);
     println!("| … nowhere (a dead end or a loop), % | {:.1} |", ends[4]);
     println!("| land draining to the sea (exorheic), % | {:.1} |", s.exorheic_pct());
     Ok(())

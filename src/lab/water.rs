@@ -7,8 +7,8 @@
 //! global river maps it is compared with.
 
 use crate::terrain::hydrology::drainage::{D8, NO_DOWN};
-use crate::terrain::hydrology::{grid, Kind, WaterColumns, CELL_METRES, RIVER_DISCHARGE};
-use crate::terrain::pipeline::channel;
+use crate::terrain::hydrology::{continental, grid, Kind, WaterColumns, CELL_METRES, RIVER_DISCHARGE};
+use crate::terrain::pipeline::{channel, COARSE_METRES};
 use crate::terrain::{Pipeline, Rect};
 
 /// Blocks per side of the tiles the columns are asked for in.
@@ -35,8 +35,9 @@ pub struct WaterStats {
     /// the world).
     pub river_km_drawn: f64,
     /// Of the drawn river length: km ending in the sea, in a lake, in a dry basin, leaving
-    /// the followed window ([`FOLLOW_CELLS`] past the region) without an end, and ending
-    /// nowhere (a dead end on land or a loop: a defect).
+    /// the followed window ([`FOLLOW_CELLS`] past the region) and finding no end down the
+    /// continent's drainage either, and ending nowhere (a dead end on land or a loop: a
+    /// defect). Past the window a path goes on down the continent's trunk rivers.
     pub ends_km: [f64; 5],
     /// Area of land cells draining to the sea (km²) and to an inland sink (lake without
     /// outlet or dry basin).
@@ -93,6 +94,33 @@ fn network_stats(pipeline: &Pipeline, area: Rect, s: &mut WaterStats) {
         (d != NO_DOWN).then(|| (y + D8[d as usize].0, x + D8[d as usize].1))
     };
     let inside = |y: i64, x: i64| y >= window.y0 && y < window.y1() && x >= window.x0 && x < window.x1();
+    // Past the followed window a path is followed on, down the continent's own drainage
+    // (the trunk rivers the network's windows have burned in): 0 sea, 2 dry basin, 3 no end.
+    let ends_beyond = std::cell::RefCell::new(std::collections::HashMap::new());
+    let beyond = |y: i64, x: i64| -> usize {
+        let f = (COARSE_METRES / CELL_METRES).round() as i64;
+        let mut c = (y.div_euclid(f), x.div_euclid(f));
+        if let Some(&end) = ends_beyond.borrow().get(&c) {
+            return end;
+        }
+        let start = c;
+        let mut end = 3;
+        for _ in 0..4 * FOLLOW_CELLS {
+            let t = pipeline.continent(Rect::new(c.0, c.1, 1, 1));
+            let code = t.get(continental::channel::DOWN, c.0, c.1) as i8;
+            if code == NO_DOWN {
+                if t.get(continental::channel::CARVED, c.0, c.1) < 0.0 {
+                    end = 0;
+                } else if t.get(continental::channel::RISE, c.0, c.1) > 0.0 {
+                    end = 2;
+                }
+                break;
+            }
+            c = (c.0 + D8[code as usize].0, c.1 + D8[code as usize].1);
+        }
+        ends_beyond.borrow_mut().insert(start, end);
+        end
+    };
     // Where each cell's water ends: 0 sea, 1 lake, 2 dry basin, 3 beyond the window, 4 nowhere
     // (a dead end on land, or a loop).
     let end_of = |mut y: i64, mut x: i64| -> usize {
@@ -105,7 +133,7 @@ fn network_stats(pipeline: &Pipeline, area: Rect, s: &mut WaterStats) {
             }
             match down(y, x) {
                 Some((ny, nx)) if inside(ny, nx) => (y, x) = (ny, nx),
-                Some(_) => return 3,
+                Some((ny, nx)) => return beyond(ny, nx),
                 None => return 4,
             }
         }
@@ -122,6 +150,7 @@ fn network_stats(pipeline: &Pipeline, area: Rect, s: &mut WaterStats) {
             }
             match down(y, x) {
                 Some((ny, nx)) if inside(ny, nx) => (y, x) = (ny, nx),
+                Some((ny, nx)) => return beyond(ny, nx),
                 _ if kind(y, x) == Kind::Lake => return 1,
                 _ => return 3,
             }
