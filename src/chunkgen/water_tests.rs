@@ -125,7 +125,7 @@ fn is_source(b: BlockState) -> bool {
 }
 
 fn is_water(b: BlockState) -> bool {
-    b.to_kind() == BlockState::WATER.to_kind()
+    b.to_kind() == BlockState::WATER.to_kind() || b.get(PropName::Waterlogged) == Some(PropValue::True)
 }
 
 /// No water block has air below it; no still (source) water block has air beside it.
