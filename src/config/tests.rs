@@ -27,6 +27,12 @@ fn an_out_of_range_value_names_file_line_key_and_range() {
 }
 
 #[test]
+fn a_cache_too_small_for_one_chunk_is_refused() {
+    let err = parse("[engine]\ncache_mib = 4\n").unwrap_err().to_string();
+    assert_eq!(err, "config/test.toml:2: engine.cache_mib = 4 is out of range (allowed 32..=65536)");
+}
+
+#[test]
 fn unknown_keys_and_wrong_types_are_errors_with_lines() {
     let err = parse("[climate]\nlapse_rate = 6.5\n").unwrap_err().to_string();
     assert!(err.starts_with("config/test.toml:2:") && err.contains("lapse_rate"), "{err}");

@@ -133,7 +133,7 @@ impl std::fmt::Display for Backend {
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EngineSettings {
-    /// Window cache budget in MiB, shared by every stage.
+    /// Window cache budget in MiB, shared by every stage; at least [`MIN_CACHE_MIB`].
     pub cache_mib: u64,
     /// Threads evaluating missing windows of one query.
     pub threads: u64,
@@ -144,6 +144,13 @@ pub struct EngineSettings {
     /// Backend of the learned stages.
     pub backend: Backend,
 }
+
+/// The smallest window cache an owner may set, MiB. One chunk's query touches about 6 MiB of
+/// windows (most of them the continent's drainage and the climate it is drained with, a
+/// thousand kilometres around); a cache smaller than that evicts windows the same query still
+/// needs and recomputes them over and over (measured: a walk of 300 chunks went from seconds
+/// to over an hour with 1 MiB).
+pub const MIN_CACHE_MIB: u64 = 32;
 
 impl Default for EngineSettings {
     fn default() -> Self {
@@ -161,7 +168,7 @@ impl EngineSettings {
     /// Checks every value against its range, and that every learned stage's required stages
     /// run too (names and backends are checked when they are parsed).
     pub fn validate(&self) -> Result<(), RangeError> {
-        check_range("engine.cache_mib", self.cache_mib, 1, 65_536)?;
+        check_range("engine.cache_mib", self.cache_mib, MIN_CACHE_MIB, 65_536)?;
         check_range("engine.threads", self.threads, 1, 256)?;
         for stage in &self.learned {
             let spec = stage.spec();

@@ -20,6 +20,27 @@ fn finite(t: &Tile) -> bool {
     (0..t.channels).filter(|&c| c != channel::WATER_LEVEL).all(|c| t.channel(c).iter().all(|v| v.is_finite()))
 }
 
+/// A cache (MiB) a little over what one chunk's query needs (measured on a fresh pipeline
+/// built by `build` with a cache of the MiB given): below the owner's minimum on purpose, so
+/// that walking a region evicts, but never so small that a query evicts what it still needs.
+fn tight_cache_mib(build: impl Fn(u64) -> Pipeline, chunk: Rect) -> u64 {
+    let p = build(256);
+    p.columns(chunk);
+    (p.engine_stats().peak_cache_bytes as u64 * 5 / 4 >> 20) + 1
+}
+
+/// Visits `chunks` in their order on `p`, checking each against `reference`; with `far`, a
+/// chunk that far east is visited after every fourth, so that a tight cache must evict the
+/// region's windows and bring them back.
+fn visit(p: &Pipeline, chunks: Vec<Rect>, reference: &Tile, far: Option<i64>, what: &str) {
+    for (i, r) in chunks.into_iter().enumerate() {
+        assert!(same(&p.columns(r), &reference.crop(r)), "chunk {r:?} differs ({what})");
+        if let Some(dx) = far.filter(|_| i % 4 == 3) {
+            p.columns(Rect::new(r.y0, r.x0 + dx * (i as i64 + 1), 16, 16));
+        }
+    }
+}
+
 /// A deterministic shuffle (Fisher–Yates with an LCG).
 fn shuffled<T>(mut v: Vec<T>, seed: u64) -> Vec<T> {
     let mut s = seed;
@@ -66,15 +87,21 @@ fn a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
     // 96×96 blocks spread over several coarse windows, far from the origin.
     let whole = Rect::new(-1_000_040, 2_345_600, 96, 96);
     let reference = pipeline(77, 256, 1).columns(whole);
-    for (cache_mib, threads, order) in [(256, 4, 1), (1, 1, 2), (1, 4, 3)] {
+    let chunks: Vec<Rect> =
+        (0..36).map(|i| Rect::new(whole.y0 + (i / 6) * 16, whole.x0 + (i % 6) * 16, 16, 16)).collect();
+    let tight = tight_cache_mib(|mib| pipeline(77, mib, 1), chunks[0]);
+    for (cache_mib, threads, order) in [(256, 4, 1), (tight, 1, 2), (tight, 4, 3)] {
         let p = pipeline(77, cache_mib, threads);
-        let chunks: Vec<Rect> =
-            (0..36).map(|i| Rect::new(whole.y0 + (i / 6) * 16, whole.x0 + (i % 6) * 16, 16, 16)).collect();
-        for r in shuffled(chunks, order) {
-            assert!(
-                same(&p.columns(r), &reference.crop(r)),
-                "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)"
-            );
+        let far = (cache_mib == tight).then_some(300_000);
+        visit(
+            &p,
+            shuffled(chunks.clone(), order),
+            &reference,
+            far,
+            &format!("cache {cache_mib} MiB, {threads} threads"),
+        );
+        if far.is_some() {
+            assert!(p.engine_stats().evictions > 0, "a {cache_mib} MiB cache evicted nothing");
         }
     }
     assert_ne!(pipeline(78, 256, 1).columns(whole).data, reference.data, "the seed must matter");
@@ -174,10 +201,14 @@ fn far_away_costs_the_same_windows_and_never_overflows() {
     let coarse_len = (512.0 / blocks_per_coarse_cell).ceil() as i64 + 3;
     let layout = WindowLayout::square(32, 16, 0);
     // The drainage network adds its tiles (at most 2 × 2 for 512 blocks of 40 m, with the
-    // rivers' reach) and the coarse windows under their margins.
-    use crate::hydrology::{CELL_METRES, MARGIN, TILE};
+    // rivers' reach, and as many stitched ones), and those reach at most 2 × 2 tiles of the
+    // continent's drainage, whose margins hold the most coarse windows.
+    use crate::hydrology::{continental, CELL_METRES, MARGIN, TILE};
     let network_len = ((2 * TILE + 2 * MARGIN) as f64 * CELL_METRES / COARSE_METRES).ceil() as i64 + 3;
-    let bound = layout.max_windows(coarse_len.max(network_len), coarse_len.max(network_len)) + 4;
+    assert!(network_len <= continental::TILE, "a network tile's context spans at most 2 continental tiles");
+    let continental_len = 2 * continental::TILE + 2 * continental::MARGIN + 3;
+    let len = coarse_len.max(continental_len);
+    let bound = layout.max_windows(len, len) + 2 * 9 + 4 + 4;
     assert!(origin > 0 && origin <= bound, "{origin} windows at the origin, bound {bound}");
     for (x, z) in [(30_000_000, 30_000_000), (-30_000_000, -30_000_000), (-30_000_000, 29_999_488), (12_345_678, -7)] {
         let far = count(x, z);
@@ -190,19 +221,20 @@ fn far_away_costs_the_same_windows_and_never_overflows() {
 
 #[test]
 fn a_long_walk_keeps_the_cache_under_its_limit() {
-    let p = pipeline(9, 1, 2);
+    let tight = tight_cache_mib(|mib| pipeline(9, mib, 2), Rect::new(0, 0, 16, 16));
+    let p = pipeline(9, tight, 2);
     let (mut x, mut z) = (0i64, 0i64);
     let mut s = 1u64;
-    for _ in 0..300 {
+    for _ in 0..60 {
         s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         // A drift east, so new windows keep coming (steps of a few km at the default scale).
         x += 4 * (((s >> 33) % 2001) as i64 - 600);
         z += 4 * (((s >> 45) % 1001) as i64 - 500);
         p.columns(Rect::new(z, x, 16, 16));
-        assert!(p.engine_stats().cache_bytes <= 1 << 20);
+        assert!(p.engine_stats().cache_bytes <= (tight << 20) as usize);
     }
     let st = p.engine_stats();
-    assert!(st.evictions > 0 && st.peak_cache_bytes <= 1 << 20, "{st:?}");
+    assert!(st.evictions > 0 && st.peak_cache_bytes <= (tight << 20) as usize, "{st:?}");
 }
 
 #[test]
@@ -308,15 +340,21 @@ mod learned {
         assert!(reference.active_stages().contains(&"core".to_string()), "{:?}", reference.active_stages());
         let reference = reference.columns(whole);
         assert!(finite(&reference), "the learned pipeline made non-finite values");
-        for (cache_mib, threads, order) in [(256, 2, 1), (1, 2, 2)] {
+        let chunks: Vec<Rect> =
+            (0..16).map(|i| Rect::new(whole.y0 + (i / 4) * 16, whole.x0 + (i % 4) * 16, 16, 16)).collect();
+        let tight = tight_cache_mib(|mib| learned(5, &models, mib, 2), chunks[0]);
+        for (cache_mib, threads, order) in [(256, 2, 1), (tight, 2, 2)] {
             let p = learned(5, &models, cache_mib, threads);
-            let chunks: Vec<Rect> =
-                (0..16).map(|i| Rect::new(whole.y0 + (i / 4) * 16, whole.x0 + (i % 4) * 16, 16, 16)).collect();
-            for r in shuffled(chunks, order) {
-                assert!(
-                    same(&p.columns(r), &reference.crop(r)),
-                    "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)"
-                );
+            let far = (cache_mib == tight).then_some(300_000);
+            visit(
+                &p,
+                shuffled(chunks.clone(), order),
+                &reference,
+                far,
+                &format!("cache {cache_mib} MiB, {threads} threads"),
+            );
+            if far.is_some() {
+                assert!(p.engine_stats().evictions > 0, "a {cache_mib} MiB cache evicted nothing");
             }
         }
         // The learned stage really shapes the terrain: not the layout's elevation.
@@ -335,12 +373,12 @@ mod learned {
         assert!(active.contains(&"coarse".to_string()) && active.contains(&"core".to_string()), "{active:?}");
         let reference = both.columns(whole);
         assert!(finite(&reference));
-        let p = learned_stages(9, &models, 1, 2, &["coarse", "core"]);
         let chunks: Vec<Rect> =
             (0..9).map(|i| Rect::new(whole.y0 + (i / 3) * 16, whole.x0 + (i % 3) * 16, 16, 16)).collect();
-        for r in shuffled(chunks, 3) {
-            assert!(same(&p.columns(r), &reference.crop(r)), "chunk {r:?} differs (cache 1 MiB, 2 threads)");
-        }
+        let tight = tight_cache_mib(|mib| learned_stages(9, &models, mib, 2, &["coarse", "core"]), chunks[0]);
+        let p = learned_stages(9, &models, tight, 2, &["coarse", "core"]);
+        visit(&p, shuffled(chunks, 3), &reference, Some(300_000), &format!("cache {tight} MiB, 2 threads"));
+        assert!(p.engine_stats().evictions > 0, "a {tight} MiB cache evicted nothing");
         // The coarse model changes the 8 km grid the climate and the core are built on.
         let core_only = learned(9, &models, 256, 1);
         let at = |p: &Pipeline| p.coarse_elevation_at_block(whole.x0, whole.y0);
@@ -360,15 +398,21 @@ mod learned {
         assert!(both.active_stages().contains(&"detail".to_string()), "{:?}", both.active_stages());
         let reference = both.columns(whole);
         assert!(finite(&reference));
-        for (cache_mib, threads, order) in [(256, 2, 5), (1, 2, 6)] {
+        let chunks: Vec<Rect> =
+            (0..9).map(|i| Rect::new(whole.y0 + (i / 3) * 16, whole.x0 + (i % 3) * 16, 16, 16)).collect();
+        let tight = tight_cache_mib(|mib| learned_stages(4, &models, mib, 2, &["core", "detail"]), chunks[0]);
+        for (cache_mib, threads, order) in [(256, 2, 5), (tight, 2, 6)] {
             let p = learned_stages(4, &models, cache_mib, threads, &["core", "detail"]);
-            let chunks: Vec<Rect> =
-                (0..9).map(|i| Rect::new(whole.y0 + (i / 3) * 16, whole.x0 + (i % 3) * 16, 16, 16)).collect();
-            for r in shuffled(chunks, order) {
-                assert!(
-                    same(&p.columns(r), &reference.crop(r)),
-                    "chunk {r:?} differs (cache {cache_mib} MiB, {threads} threads)"
-                );
+            let far = (cache_mib == tight).then_some(300_000);
+            visit(
+                &p,
+                shuffled(chunks.clone(), order),
+                &reference,
+                far,
+                &format!("cache {cache_mib} MiB, {threads} threads"),
+            );
+            if far.is_some() {
+                assert!(p.engine_stats().evictions > 0, "a {cache_mib} MiB cache evicted nothing");
             }
         }
         // The detail model replaces the core's bilinear upsampling.
