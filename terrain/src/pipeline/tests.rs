@@ -26,7 +26,7 @@ fn finite(t: &Tile) -> bool {
 fn tight_cache_mib(build: impl Fn(u64) -> Pipeline, chunk: Rect) -> u64 {
     let p = build(256);
     p.columns(chunk);
-    (p.engine_stats().peak_cache_bytes as u64 * 5 / 4 >> 20) + 1
+    ((p.engine_stats().peak_cache_bytes as u64 * 5 / 4) >> 20) + 1
 }
 
 /// Visits `chunks` in their order on `p`, checking each against `reference`; with `far`, a
