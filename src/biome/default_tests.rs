@@ -27,6 +27,7 @@ fn ground(temperature_c: f32, precipitation_mm: f32, surface_m: f32, slope_deg: 
         surface_m,
         slope_deg,
         water: if surface_m < 0.0 { WaterBody::Sea } else { WaterBody::None },
+        river_distance_m: 640.0,
     }
 }
 
@@ -127,6 +128,25 @@ fn the_shipped_rules_cover_every_realistic_cell_and_reach_every_required_biome()
     assert!(missing.is_empty(), "never produced: {missing:?}");
     assert!(reached.iter().all(|b| OVERWORLD_BIOMES.contains(b)));
     assert_eq!(rules.biome_names().len(), reached.len(), "every biome in the rules is reachable");
+}
+
+#[test]
+fn dry_land_has_gallery_forests_along_its_rivers() {
+    let rules = shipped();
+    let at = |t: f32, p: f32, river_distance_m: f32| {
+        rules.biome(&Conditions { river_distance_m, ..ground(t, p, 200.0, 1.0) })
+    };
+    // Temperate steppe: forest within 160 m of a river's bank, grassland beyond.
+    assert_eq!((at(12.0, 300.0, 80.0), at(12.0, 300.0, 640.0)), ("minecraft:forest", "minecraft:plains"));
+    // Hot and dry: acacia woodland along the river through the desert.
+    assert_eq!((at(24.0, 200.0, 0.0), at(24.0, 200.0, 640.0)), ("minecraft:savanna", "minecraft:desert"));
+    // Wet land is forest anyway; the river itself and the hyper-arid desert are untouched.
+    assert_eq!(at(12.0, 900.0, 80.0), at(12.0, 900.0, 640.0));
+    assert_eq!(at(24.0, 50.0, 80.0), "minecraft:desert");
+    assert_eq!(
+        rules.biome(&Conditions { water: WaterBody::River, river_distance_m: 0.0, ..ground(12.0, 300.0, 200.0, 1.0) }),
+        "minecraft:river"
+    );
 }
 
 #[test]

@@ -31,6 +31,7 @@ pub(crate) const RULE_KEYS: &[&str] = &[
     DEPTH_KEY,
     "slope_deg",
     "water",
+    "river_distance_m",
 ];
 
 /// What a range key must hold.

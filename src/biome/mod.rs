@@ -50,6 +50,9 @@ pub struct Conditions {
     pub slope_deg: f32,
     /// The water the cell's columns hold.
     pub water: WaterBody,
+    /// Distance from the cell's sample column to the nearest river's bank, metres: 0 in a
+    /// river, at most 640 (what every column farther away reads).
+    pub river_distance_m: f32,
 }
 
 /// The water body of a biome cell, for a rule's `water` condition.

@@ -3,9 +3,9 @@
 
 use super::{Conditions, WaterBody};
 
-/// Lanes of a compiled box: the eight axes, so a box is two 32-byte rows the compiler can
+/// Lanes of a compiled box: the nine axes, so a box is two short rows the compiler can
 /// compare with a few vector instructions and no branch per axis.
-pub(crate) const LANES: usize = 8;
+pub(crate) const LANES: usize = 9;
 
 /// One physical quantity a rule can constrain.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,11 +19,13 @@ pub(crate) enum Axis {
     Slope,
     /// The column's water body, as its [`WaterBody`] code (a rule names kinds, never codes).
     Water,
+    /// Distance to the nearest river's bank, metres.
+    RiverDistance,
 }
 
 impl Axis {
     /// Every axis, in lane order.
-    pub(crate) const ALL: [Axis; 8] = [
+    pub(crate) const ALL: [Axis; LANES] = [
         Axis::Temperature,
         Axis::Seasonality,
         Axis::Precipitation,
@@ -32,6 +34,7 @@ impl Axis {
         Axis::Surface,
         Axis::Slope,
         Axis::Water,
+        Axis::RiverDistance,
     ];
 
     /// The lane this axis occupies in a compiled box.
@@ -50,6 +53,7 @@ impl Axis {
             Axis::Surface => "surface_m",
             Axis::Slope => "slope_deg",
             Axis::Water => "water",
+            Axis::RiverDistance => "river_distance_m",
         }
     }
 
@@ -64,6 +68,7 @@ impl Axis {
             Axis::Elevation | Axis::Surface => (-12_000.0, 12_000.0),
             Axis::Slope => (0.0, 90.0),
             Axis::Water => (0.0, WaterBody::ALL.len() as f32),
+            Axis::RiverDistance => (0.0, 100_000.0),
         }
     }
 }
@@ -81,6 +86,7 @@ impl Conditions {
             self.surface_m,
             self.slope_deg,
             self.water as u8 as f32,
+            self.river_distance_m,
         ]
     }
 }
@@ -207,6 +213,7 @@ mod tests {
             surface_m: 100.0,
             slope_deg: 1.0,
             water: WaterBody::None,
+            river_distance_m: 640.0,
         }
     }
 

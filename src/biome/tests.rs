@@ -36,6 +36,7 @@ fn cell(temperature_c: f32, precipitation_mm: f32) -> Conditions {
         surface_m: 200.0,
         slope_deg: 2.0,
         water: WaterBody::None,
+        river_distance_m: 640.0,
     }
 }
 
@@ -195,6 +196,23 @@ fn water_conditions_name_kinds_and_lists_must_be_gapless() {
         assert!(message.starts_with("biomes/default.toml:5: rule \"r\": "), "{message}");
         assert!(message.contains(expected), "{water}: {message}");
     }
+}
+
+#[test]
+fn river_distance_is_a_range_in_metres_from_the_bank() {
+    let text =
+        format!("{FALLBACK}[[rule]]\nname = \"banks\"\nbiome = \"minecraft:forest\"\nriver_distance_m = [0, 160]\n");
+    let rules = BiomeRules::from_sources(&[(PathBuf::from("biomes/default.toml"), text)]).unwrap();
+    let at = |river_distance_m| rules.biome(&Conditions { river_distance_m, ..cell(10.0, 400.0) });
+    assert_eq!(
+        (at(0.0), at(159.0), at(160.0), at(640.0)),
+        ("minecraft:forest", "minecraft:forest", "minecraft:plains", "minecraft:plains")
+    );
+    let message = one_file_error(&format!(
+        "{FALLBACK}[[rule]]\nname = \"r\"\nbiome = \"minecraft:forest\"\nriver_distance_m = [-5, 100]\n"
+    ));
+    assert!(message.starts_with("biomes/default.toml:5: rule \"r\": "), "{message}");
+    assert!(message.contains("`river_distance_m`: min -5 is below the lowest possible value 0"), "{message}");
 }
 
 #[test]
@@ -421,6 +439,7 @@ fn a_hundred_thousand_lookups_stay_linear() {
             surface_m: (i % 41) as f32 * 100.0 - 1000.0,
             slope_deg: (i % 13) as f32,
             water: WaterBody::None,
+            river_distance_m: (i % 7) as f32 * 100.0,
         };
         *counts.entry(rules.biome(&c)).or_insert(0u32) += 1;
     }

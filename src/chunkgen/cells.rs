@@ -51,6 +51,7 @@ pub fn ground_conditions(columns: &Columns, x: i64, z: i64) -> Conditions {
         surface_m,
         slope_deg: columns.slope_deg(x, z),
         water: water_body(columns, x, z),
+        river_distance_m: columns.get(channel::RIVER_DISTANCE, x, z),
     }
 }
 

@@ -269,6 +269,23 @@ fn rivers_and_lakes_sit_right_drain_downhill_and_are_river_biomes() {
                 && region.columns.water(x, z + 1) == Water::River
     });
     assert!(crossing, "no river crosses a chunk border");
+    // The distance to a river's bank (the rules' `river_distance_m`): 0 in river water and
+    // never on dry ground, growing about a block a block away.
+    let block_m = g.pipeline().block_metres() as f32;
+    let distance = |x: i64, z: i64| region.columns.get(crate::terrain::pipeline::channel::RIVER_DISTANCE, x, z);
+    let rect = region.rect();
+    for (x, z) in region.each_column() {
+        let (d, water) = (distance(x, z), region.columns.water(x, z));
+        assert!(water != Water::River || d == 0.0, "river column ({x}, {z}) is {d} m from a river");
+        assert!(d > 0.0 || water != Water::Dry, "dry column ({x}, {z}) lies in a river's bed");
+        for (nx, nz) in [(x + 1, z), (x, z + 1)] {
+            if nx < rect.x1() && nz < rect.y1() {
+                let step = (distance(nx, nz) - d).abs();
+                assert!(step <= 1.5 * block_m, "the distance jumps {step} m from ({x}, {z}) to ({nx}, {nz})");
+            }
+        }
+    }
+    assert!(region.each_column().any(|(x, z)| (100.0..600.0).contains(&distance(x, z))));
     // The river biome over river water.
     let palette = BiomePalette::vanilla();
     let (river, frozen) = (palette.id("minecraft:river"), palette.id("minecraft:frozen_river"));

@@ -10,7 +10,8 @@
 //! this scale are closed nearly everywhere (noise has pits at every scale; Earth's have been
 //! cut through by their outlets): filled, they covered a quarter of an inland region with
 //! lake. So here a wet basin is breached (its outlet cut down until it drains, Soille's
-//! carving), a dry one is filled, and three things are handed down to the network's windows:
+//! carving) unless it is deep and small (kept as a lake, [`LAKE_KEEP_DEPTH_M`]), a dry one is
+//! filled, and three things are handed down to the network's windows:
 //! the cut lowers the elevation they drain, the fill raises their edges
 //! ([`super::drainage::Inputs::edge_rise`]), and the trunk rivers are burned in ([`burn`]) so
 //! that every window sees the same way to the sea. Measured on an inland region 300 km from
@@ -25,6 +26,18 @@ use crate::tile::{Rect, Tile};
 
 use super::drainage::{breach, drain, runoff_mm, Inputs, Kind, D8, NO_DOWN, SECONDS_PER_YEAR};
 use super::input;
+
+/// A wet basin at least this deep (its spill level over its lowest cell, metres) and at
+/// most [`LAKE_KEEP_MAX_CELLS`] across is kept as a lake, not breached: Earth's outlets cut
+/// through the shallow sills of noise, not through the rim of a deep basin (Crater Lake,
+/// Baikal, the Alpine lakes). Every wet basin breached left an inland region 0.10 % lake
+/// (Earth: 1.8 %, HydroLAKES).
+pub const LAKE_KEEP_DEPTH_M: f32 = 60.0;
+/// The widest wet basin kept as a lake, coarse cells (40 km at 8 km): with no limit, the
+/// relief's continental basins, hundreds of kilometres across, were kept — an inland region
+/// became 10.4 % lake and none of it drained to the sea (network windows, 128 km, cannot
+/// see past such a basin; the trunk rivers are what carry water across it).
+pub const LAKE_KEEP_MAX_CELLS: usize = 5;
 
 /// Side of a drained tile, coarse cells.
 pub const TILE: i64 = 64;
@@ -89,7 +102,11 @@ impl WindowFn for Continental {
                     inflow: None,
                     edge_rise: None,
                 });
-                let closed: Vec<bool> = d.kind.iter().map(|&k| k == Kind::Dry).collect();
+                let dry: Vec<bool> = d.kind.iter().map(|&k| k == Kind::Dry).collect();
+                // Dry basins and kept lakes hold their water: not cut into. A kept lake's
+                // water still flows on through its outlet; a dry basin's ends in it.
+                let kept = kept_lakes(h, w, e, &d.level, &d.kind);
+                let closed: Vec<bool> = dry.iter().zip(&kept).map(|(&a, &b)| a || b).collect();
                 let cut = breach(h, w, e, &d.filled, &closed);
                 // Discharge along the carved surface; a dry basin's water ends in it.
                 let n = h * w;
@@ -100,7 +117,7 @@ impl WindowFn for Continental {
                         let mm = runoff_mm(t.channel(input::PRECIPITATION)[c], t.channel(input::TEMPERATURE)[c]);
                         discharge[c] += mm / 1000.0 * area / SECONDS_PER_YEAR;
                     }
-                    if closed[c] || cut.down[c] == NO_DOWN {
+                    if dry[c] || cut.down[c] == NO_DOWN {
                         continue;
                     }
                     let (dy, dx) = D8[cut.down[c] as usize];
@@ -113,7 +130,7 @@ impl WindowFn for Continental {
                         data[channel::RISE * n + i] = (d.filled[i] - e[i]).max(0.0);
                     }
                     data[channel::LOWER * n + i] = cut.lower[i];
-                    data[channel::DOWN * n + i] = if closed[i] { f32::from(NO_DOWN) } else { f32::from(cut.down[i]) };
+                    data[channel::DOWN * n + i] = if dry[i] { f32::from(NO_DOWN) } else { f32::from(cut.down[i]) };
                     data[channel::CARVED * n + i] = cut.carved[i];
                     data[channel::DISCHARGE * n + i] = discharge[i] as f32;
                 }
@@ -121,6 +138,49 @@ impl WindowFn for Continental {
             })
             .collect()
     }
+}
+
+/// The cells of the wet basins kept as lakes ([`LAKE_KEEP_DEPTH_M`], [`LAKE_KEEP_MAX_CELLS`])
+/// of a drained `h` × `w` window: each lake (its [`Kind::Lake`] cells and the shallower
+/// ones under the same level, 8-connected) whole, or not at all.
+fn kept_lakes(h: usize, w: usize, e: &[f32], level: &[f32], kind: &[Kind]) -> Vec<bool> {
+    let n = h * w;
+    let mut seen = vec![false; n];
+    let mut kept = vec![false; n];
+    for start in 0..n {
+        if seen[start] || kind[start] != Kind::Lake {
+            continue;
+        }
+        let surface = level[start];
+        let (mut cells, mut stack) = (vec![start], vec![start]);
+        seen[start] = true;
+        while let Some(c) = stack.pop() {
+            let (cy, cx) = ((c / w) as i64, (c % w) as i64);
+            for &(dy, dx) in &D8 {
+                let (ny, nx) = (cy + dy, cx + dx);
+                if ny < 0 || nx < 0 || ny >= h as i64 || nx >= w as i64 {
+                    continue;
+                }
+                let m = ny as usize * w + nx as usize;
+                if !seen[m] && level[m] == surface && e[m] < surface {
+                    seen[m] = true;
+                    cells.push(m);
+                    stack.push(m);
+                }
+            }
+        }
+        let depth = cells.iter().map(|&c| surface - e[c]).fold(0.0, f32::max);
+        let span = |f: &dyn Fn(usize) -> usize| {
+            let (lo, hi) = cells.iter().fold((usize::MAX, 0), |(lo, hi), &c| (lo.min(f(c)), hi.max(f(c))));
+            hi - lo + 1
+        };
+        if depth >= LAKE_KEEP_DEPTH_M && span(&|c| c / w).max(span(&|c| c % w)) <= LAKE_KEEP_MAX_CELLS {
+            for c in cells {
+                kept[c] = true;
+            }
+        }
+    }
+    kept
 }
 
 /// Discharge from which the continent's rivers are burned into the network's relief, m³/s:
@@ -215,6 +275,46 @@ mod tests {
             t.data[channel::DOWN * n + i] = if x < 3 { 4.0 } else { f32::from(NO_DOWN) };
         }
         t
+    }
+
+    #[test]
+    fn deep_small_wet_basins_are_kept_as_lakes_and_the_rest_breached() {
+        // 12 × 12 cells of 8 km at 200 m, its edge the outlet at 150 m, with three pits: deep
+        // and small (rows 2–4, columns 2–4, at 100 m), deep and wide (rows 7–8, columns 1–10),
+        // shallow (rows 2–3, columns 7–8, at 170 m).
+        let (h, w) = (12, 12);
+        let mut e = vec![200.0f32; h * w];
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                if y == 0 || x == 0 || y == h - 1 || x == w - 1 {
+                    e[i] = 150.0;
+                } else if (2..5).contains(&y) && (2..5).contains(&x) || (7..9).contains(&y) && (1..11).contains(&x) {
+                    e[i] = 100.0;
+                } else if (2..4).contains(&y) && (7..9).contains(&x) {
+                    e[i] = 170.0;
+                }
+            }
+        }
+        let n = h * w;
+        let d = drain(&Inputs {
+            h,
+            w,
+            cell_m: 8000.0,
+            elevation: &e,
+            precipitation: &vec![2000.0; n],
+            temperature: &vec![5.0; n],
+            inflow: None,
+            edge_rise: None,
+        });
+        let kept = kept_lakes(h, w, &e, &d.level, &d.kind);
+        let small: Vec<usize> = (2..5).flat_map(|y| (2..5).map(move |x| y * w + x)).collect();
+        assert!(small.iter().all(|&i| kept[i]), "the deep small basin is kept whole");
+        assert_eq!(kept.iter().filter(|&&k| k).count(), small.len(), "nothing else is kept: {kept:?}");
+        // Kept, it is not cut into; the wide one is breached through its rim.
+        let cut = breach(h, w, &e, &d.filled, &kept);
+        assert!(small.iter().all(|&i| cut.lower[i] == 0.0 && cut.carved[i] >= d.level[i] - 0.01));
+        assert!(cut.lower.iter().any(|&l| l >= 50.0), "the wide basin's rim is cut down");
     }
 
     #[test]

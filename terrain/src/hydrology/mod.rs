@@ -29,7 +29,10 @@ use crate::infinite::{Source, WindowFn, WindowIndex, WindowLayout};
 use crate::resample;
 use crate::tile::{Rect, Tile};
 pub use drainage::Kind;
-pub use rivers::{water_width_m, Course, Rivers, WaterColumns, DRY_BED_DEPTH_M, RIVER_DISCHARGE};
+pub use rivers::{
+    flared_width_m, water_width_m, Course, Rivers, WaterColumns, DRY_BED_DEPTH_M, ESTUARY_FLARE, RIVER_DISCHARGE,
+    RIVER_DISTANCE_MAX_M,
+};
 pub use stitch::Stitched;
 
 /// Size of a cell of the drainage network, metres.

@@ -46,6 +46,13 @@ const SHORE_RISE_M: f64 = 40.0;
 const SHORE_WARP: f64 = 0.3;
 /// Frequency of the shore-warping noise, per cell.
 const SHORE_WARP_FREQ: f64 = 1.7;
+/// How many times wider than upstream a river is where it meets the sea: over its last cell
+/// it widens to twice its width, over its mouth to this (an estuary, as tides and the sea's
+/// salt water widen real ones), never past [`MAX_WIDTH_M`].
+pub const ESTUARY_FLARE: f64 = 4.0;
+/// How far from a river's bank [`WaterColumns::river_distance`] counts, metres (the reach of
+/// its valley); farther columns read this.
+pub const RIVER_DISTANCE_MAX_M: f64 = VALLEY_REACH_M;
 /// Channel depth at a river's centre, blocks, for the smallest river; one more per ×10
 /// discharge, at most [`MAX_DEPTH_BLOCKS`].
 const MAX_DEPTH_BLOCKS: f64 = 4.0;
@@ -55,6 +62,13 @@ const MAX_DEPTH_BLOCKS: f64 = 4.0;
 /// [`MIN_WIDTH_BLOCKS`] blocks.
 pub fn water_width_m(q: f64, block_m: f64) -> f64 {
     (WIDTH_EXAGGERATION * 4.0 * q.max(0.0).sqrt()).min(MAX_WIDTH_M).max(MIN_WIDTH_BLOCKS * block_m)
+}
+
+/// [`water_width_m`] widened `flare` times (an estuary, [`ESTUARY_FLARE`]), at most
+/// [`MAX_WIDTH_M`] unless the river is already wider.
+pub fn flared_width_m(q: f64, flare: f64, block_m: f64) -> f64 {
+    let w = water_width_m(q, block_m);
+    (w * flare).min(MAX_WIDTH_M).max(w)
 }
 
 /// What [`Rivers::columns`] says of each block column, row-major over the rectangle.
@@ -67,6 +81,9 @@ pub struct WaterColumns {
     pub kind: Vec<u8>,
     /// Discharge of the river or lake, m³/s (0 elsewhere).
     pub discharge: Vec<f32>,
+    /// Distance from the column to the nearest river's bank, metres: 0 in a river, at most
+    /// [`RIVER_DISTANCE_MAX_M`] (what every column farther away reads).
+    pub river_distance: Vec<f32>,
 }
 
 impl WaterColumns {
@@ -82,19 +99,21 @@ pub struct Course {
     pub discharge: f64,
 }
 
-/// One curve of a river's course: points (x, z metres), discharge and water level along it.
+/// One curve of a river's course: points (x, z metres), discharge, water level and width
+/// factor ([`ESTUARY_FLARE`]) along it.
 struct Piece {
-    points: Vec<[f64; 4]>,
+    points: Vec<[f64; 5]>,
     lo: (f64, f64),
     hi: (f64, f64),
     reach: f64,
 }
 
 impl Piece {
-    /// A quadratic Bézier from `a` via `b` to `c` (each x, z, discharge, level): discharge
-    /// linear along it, the level a Bézier too (so it never rises where the three levels fall).
-    fn new(a: [f64; 4], b: [f64; 4], c: [f64; 4], block_m: f64) -> Piece {
-        let points: Vec<[f64; 4]> = (0..=SEGMENTS)
+    /// A quadratic Bézier from `a` via `b` to `c` (each x, z, discharge, level, width
+    /// factor): discharge and width factor linear along it, the level a Bézier too (so it
+    /// never rises where the three levels fall).
+    fn new(a: [f64; 5], b: [f64; 5], c: [f64; 5], block_m: f64) -> Piece {
+        let points: Vec<[f64; 5]> = (0..=SEGMENTS)
             .map(|k| {
                 let t = k as f64 / SEGMENTS as f64;
                 let (u, v, w) = ((1.0 - t) * (1.0 - t), 2.0 * t * (1.0 - t), t * t);
@@ -103,19 +122,20 @@ impl Piece {
                     u * a[1] + v * b[1] + w * c[1],
                     a[2] + t * (c[2] - a[2]),
                     u * a[3] + v * b[3] + w * c[3],
+                    a[4] + t * (c[4] - a[4]),
                 ]
             })
             .collect();
-        let q = a[2].max(c[2]);
-        let reach = water_width_m(q, block_m) + VALLEY_REACH_M;
+        let reach = flared_width_m(a[2].max(c[2]), a[4].max(c[4]), block_m) + VALLEY_REACH_M;
         let lo = points.iter().fold((f64::INFINITY, f64::INFINITY), |m, p| (m.0.min(p[0]), m.1.min(p[1])));
         let hi = points.iter().fold((f64::NEG_INFINITY, f64::NEG_INFINITY), |m, p| (m.0.max(p[0]), m.1.max(p[1])));
         Piece { points, lo, hi, reach }
     }
 
-    /// Distance (metres) from (`x`, `z`) to the curve, and the discharge and level there.
-    fn nearest(&self, x: f64, z: f64) -> (f64, f64, f64) {
-        let mut best = (f64::INFINITY, 0.0, 0.0);
+    /// Distance (metres) from (`x`, `z`) to the curve, and the discharge, level and width
+    /// factor there.
+    fn nearest(&self, x: f64, z: f64) -> (f64, f64, f64, f64) {
+        let mut best = (f64::INFINITY, 0.0, 0.0, 1.0);
         for s in self.points.windows(2) {
             let (p, q) = (s[0], s[1]);
             let (dx, dz) = (q[0] - p[0], q[1] - p[1]);
@@ -123,7 +143,7 @@ impl Piece {
             let t = if len2 > 0.0 { (((x - p[0]) * dx + (z - p[1]) * dz) / len2).clamp(0.0, 1.0) } else { 0.0 };
             let d = (x - p[0] - t * dx).hypot(z - p[1] - t * dz);
             if d < best.0 {
-                best = (d, p[2] + t * (q[2] - p[2]), p[3] + t * (q[3] - p[3]));
+                best = (d, p[2] + t * (q[2] - p[2]), p[3] + t * (q[3] - p[3]), p[4] + t * (q[4] - p[4]));
             }
         }
         best
@@ -214,8 +234,12 @@ impl Rivers {
                 let q = cells.discharge(cy, cx);
                 let mid = |a: (f64, f64), b: (f64, f64)| ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
                 let m = mid(pc, pd);
-                let end = [m.0, m.1, q, (here + there) / 2.0];
-                let centre = [pc.0, pc.1, q, here];
+                // A river that meets the sea widens over its last cell and its mouth (an
+                // estuary): width factors 1 → √flare → flare.
+                let estuary = cells.kind(dy, dx) == Kind::Sea;
+                let (f_end, f_last) = if estuary { (ESTUARY_FLARE.sqrt(), ESTUARY_FLARE) } else { (1.0, 1.0) };
+                let end = [m.0, m.1, q, (here + there) / 2.0, f_end];
+                let centre = [pc.0, pc.1, q, here, 1.0];
                 let mut upstream = 0;
                 for &(oy, ox) in &D8 {
                     let (uy, ux) = (cy + oy, cx + ox);
@@ -228,23 +252,23 @@ impl Rivers {
                     let pu = self.node(uy, ux);
                     let s = mid(pu, pc);
                     let level = (cells.level(uy, ux).max(here) + here) / 2.0;
-                    out.push(Piece::new([s.0, s.1, cells.discharge(uy, ux), level], centre, end, block_m));
+                    out.push(Piece::new([s.0, s.1, cells.discharge(uy, ux), level, 1.0], centre, end, block_m));
                 }
                 if upstream == 0 {
                     // A source: the course starts at the node.
                     out.push(Piece::new(
                         centre,
-                        [(pc.0 + m.0) / 2.0, (pc.1 + m.1) / 2.0, q, (here + end[3]) / 2.0],
+                        [(pc.0 + m.0) / 2.0, (pc.1 + m.1) / 2.0, q, (here + end[3]) / 2.0, 1.0],
                         end,
                         block_m,
                     ));
                 }
                 if matches!(cells.kind(dy, dx), Kind::Sea | Kind::Lake | Kind::Dry) {
                     // The mouth: on into the sea, the lake or the dry basin's bed.
-                    let last = [pd.0, pd.1, q, there];
+                    let last = [pd.0, pd.1, q, there, f_last];
                     out.push(Piece::new(
                         end,
-                        [(m.0 + pd.0) / 2.0, (m.1 + pd.1) / 2.0, q, (end[3] + there) / 2.0],
+                        [(m.0 + pd.0) / 2.0, (m.1 + pd.1) / 2.0, q, (end[3] + there) / 2.0, 1.0],
                         last,
                         block_m,
                     ));
@@ -296,20 +320,26 @@ impl Rivers {
         let pieces: Vec<Piece> =
             self.pieces(&cells, nodes, block_m).into_iter().filter(|p| p.touches(lo, hi)).collect();
 
-        let mut out =
-            WaterColumns { level: vec![f32::NAN; n], kind: vec![Kind::Land as u8; n], discharge: vec![0.0; n] };
+        let mut out = WaterColumns {
+            level: vec![f32::NAN; n],
+            kind: vec![Kind::Land as u8; n],
+            discharge: vec![0.0; n],
+            river_distance: vec![RIVER_DISTANCE_MAX_M as f32; n],
+        };
         let mut i = 0;
         for z in blocks.y0..blocks.y1() {
             for x in blocks.x0..blocks.x1() {
                 let (xm, zm) = ((x as f64 + 0.5) * block_m, (z as f64 + 0.5) * block_m);
                 let mut e = f64::from(elevation[i]);
                 let mut river: Option<(f64, f64, f64)> = None;
+                let mut bank = RIVER_DISTANCE_MAX_M;
                 for p in &pieces {
-                    let (d, q, level) = p.nearest(xm, zm);
+                    let (d, q, level, flare) = p.nearest(xm, zm);
                     if d >= p.reach {
                         continue;
                     }
-                    let half = water_width_m(q, block_m) / 2.0;
+                    let half = flared_width_m(q, flare, block_m) / 2.0;
+                    bank = bank.min((d - half).max(0.0));
                     let plain = 2.0 * half;
                     let floor = level + VALLEY_SLOPE * (d - plain).max(0.0);
                     let weight = if d <= plain { 1.0 } else { smoothstep(1.0 - (d - plain) / (p.reach - plain)) };
@@ -335,6 +365,7 @@ impl Rivers {
                         out.discharge[i] = if kind == Kind::Lake { q as f32 } else { 0.0 };
                     }
                 }
+                out.river_distance[i] = bank as f32;
                 elevation[i] = e as f32;
                 i += 1;
             }
@@ -392,4 +423,95 @@ impl Rivers {
 fn smoothstep(t: f64) -> f64 {
     let t = t.clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::grid;
+    use super::*;
+
+    /// A network with one river along cell row 0, west to east, from cell x 0 to 9, into a
+    /// sea from cell x 10 on; every other cell is land without a river.
+    struct OneRiver;
+
+    impl Source for OneRiver {
+        fn channels(&self) -> usize {
+            grid::COUNT
+        }
+
+        fn query(&self, rect: Rect) -> Tile {
+            let mut t = Tile::zeros(grid::COUNT, rect);
+            let n = rect.area();
+            let mut i = 0;
+            for y in rect.y0..rect.y1() {
+                for x in rect.x0..rect.x1() {
+                    let (kind, down, q, level) = if x >= 10 {
+                        (Kind::Sea, NO_DOWN, 0.0, 0.0)
+                    } else if y == 0 && x >= 0 {
+                        (Kind::Land, 4, 100.0, 50.0 - 5.0 * x as f32)
+                    } else {
+                        (Kind::Land, NO_DOWN, 0.0, 100.0)
+                    };
+                    t.data[grid::KIND * n + i] = kind as u8 as f32;
+                    t.data[grid::DOWN * n + i] = f32::from(down);
+                    t.data[grid::DISCHARGE * n + i] = q;
+                    t.data[grid::LEVEL * n + i] = level;
+                    t.data[grid::FILLED * n + i] = level;
+                    i += 1;
+                }
+            }
+            t
+        }
+    }
+
+    const BLOCK_M: f64 = 40.0;
+
+    /// The water of a line of block columns across the river (north to south) at `x_m`
+    /// metres east: 3 km long, land at 100 m west of the sea, sea floor at −10 m.
+    fn across(x_m: f64) -> WaterColumns {
+        let x = (x_m / BLOCK_M).floor() as i64;
+        let blocks = Rect::new(-40, x, 80, 1);
+        let mut elevation = vec![if x_m < 10_000.0 { 100.0 } else { -10.0 }; blocks.area()];
+        Rivers::new(Arc::new(OneRiver), 3).columns(blocks, BLOCK_M, 25.0, &mut elevation)
+    }
+
+    fn river_columns(w: &WaterColumns) -> usize {
+        w.kind.iter().filter(|&&k| k == WaterColumns::RIVER).count()
+    }
+
+    #[test]
+    fn a_river_widens_into_an_estuary_where_it_meets_the_sea() {
+        let upstream = river_columns(&across(3_500.0));
+        let width = |q: f64, f: f64| flared_width_m(q, f, BLOCK_M) / BLOCK_M;
+        // 3·4·√100 m = 120 m: three blocks (a column's centre may fall either side of a bank).
+        assert!((width(100.0, 1.0) - 1.0..=width(100.0, 1.0) + 1.0).contains(&(upstream as f64)), "{upstream}");
+        // Over the last cell the river widens, over its mouth to ESTUARY_FLARE times.
+        let widths: Vec<usize> =
+            [8_500.0, 9_200.0, 9_800.0, 10_300.0].iter().map(|&x| river_columns(&across(x))).collect();
+        assert!(widths.windows(2).all(|w| w[1] >= w[0]), "an estuary widens towards the sea: {widths:?}");
+        assert!(widths[3] as f64 >= 0.75 * ESTUARY_FLARE * upstream as f64, "{widths:?} from {upstream}");
+        // Never past the widest river, however large the flare.
+        assert_eq!(flared_width_m(1e6, ESTUARY_FLARE, BLOCK_M), MAX_WIDTH_M);
+        assert_eq!(flared_width_m(4.0, 1.0, BLOCK_M), water_width_m(4.0, BLOCK_M));
+    }
+
+    #[test]
+    fn the_distance_to_a_river_is_zero_in_it_and_grows_like_a_distance_away_from_it() {
+        let w = across(3_500.0);
+        for (i, (&k, &d)) in w.kind.iter().zip(&w.river_distance).enumerate() {
+            assert_eq!(k == WaterColumns::RIVER, d == 0.0, "column {i}: kind {k}, distance {d}");
+        }
+        // One block further from the river is at most one block further from its bank.
+        assert!(
+            w.river_distance.windows(2).all(|p| (p[1] - p[0]).abs() <= BLOCK_M as f32 + 1e-3),
+            "{:?}",
+            w.river_distance
+        );
+        // Far off (1.6 km) the distance reads its ceiling; half-way it is a few hundred metres.
+        assert_eq!(
+            (w.river_distance[0], w.river_distance[79]),
+            (RIVER_DISTANCE_MAX_M as f32, RIVER_DISTANCE_MAX_M as f32)
+        );
+        assert!(w.river_distance.iter().any(|&d| (200.0..500.0).contains(&d)), "{:?}", w.river_distance);
+    }
 }

@@ -21,7 +21,7 @@ use crate::climate::{precipitation, temperature_at, Orographic};
 use crate::encoding::box_downsample;
 use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
 use crate::hydrology::continental::Continental;
-use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns, CELL_METRES};
+use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns, CELL_METRES, RIVER_DISTANCE_MAX_M};
 use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
@@ -65,8 +65,12 @@ pub mod channel {
     pub const WATER: usize = 7;
     /// Discharge of the river or lake, m³/s (0 elsewhere).
     pub const DISCHARGE: usize = 8;
+    /// Distance to the nearest river's bank, metres: 0 in a river, at most
+    /// [`crate::hydrology::RIVER_DISTANCE_MAX_M`] (what the model grid reads
+    /// everywhere). Block columns only.
+    pub const RIVER_DISTANCE: usize = 9;
     /// Number of channels.
-    pub const COUNT: usize = 9;
+    pub const COUNT: usize = 10;
     /// Channel names, in order, for files and legends.
     pub const NAMES: [&str; COUNT] = [
         "elevation_m",
@@ -78,6 +82,7 @@ pub mod channel {
         "water_level_m",
         "water",
         "discharge_m3s",
+        "river_distance_m",
     ];
 }
 
@@ -336,6 +341,7 @@ impl Pipeline {
             *d = s.atan().to_degrees();
         }
         out.channel_mut(channel::WATER_LEVEL).fill(f32::NAN);
+        out.channel_mut(channel::RIVER_DISTANCE).fill(RIVER_DISTANCE_MAX_M as f32);
         (out, finest.select(&[finest::SLOPE]))
     }
 
@@ -404,6 +410,7 @@ impl Pipeline {
             *d = f32::from(k);
         }
         out.channel_mut(channel::DISCHARGE).copy_from_slice(&water.discharge);
+        out.channel_mut(channel::RIVER_DISTANCE).copy_from_slice(&water.river_distance);
         out
     }
 
