@@ -1,17 +1,17 @@
 //! Chunk generation: block columns from the terrain pipeline → Minecraft chunks.
 //!
 //! Owns: the vertical mapping (metres → block Y), biomes per 4×4×4 cell, the blocks of a
-//! chunk (rock, sea, surface materials, trees and plants) and the sky light of a finished
-//! chunk. Must not touch: networking, scheduling, caching or saving (the server's and the
-//! world's: they call [`Generator::chunk`] and [`SkyLight::of`]), or how terrain is made (the
+//! chunk (rock, sea, surface materials, trees and plants) and the light (sky and block) of a
+//! finished chunk. Must not touch: networking, scheduling, caching or saving (the server's and the
+//! world's: they call [`Generator::chunk`] and [`Light::of`]), or how terrain is made (the
 //! pipeline's). Everything here is a pure function of (seed, configuration, rules, global
 //! coordinates), so chunks can be built on any thread in any order and still meet seamlessly.
 //!
 //! A chunk is built by an ordered list of passes ([`passes::PASSES`]): columns (the pipeline
 //! query and the biome of every cell) → rock → water → surface → vegetation. Each pass is one
 //! module of `passes/` with one job; it reads the shared [`ChunkContext`] and writes into the
-//! chunk. Sky light is not a pass: the server and the world saver compute it from the
-//! finished blocks ([`SkyLight::of`]).
+//! chunk. Light is not a pass: the server and the world saver compute it from the
+//! finished blocks ([`Light::of`]).
 //!
 //! Adding a pass (see docs/architecture.md, "Where to add: A chunk-generation pass"): write
 //! `passes/<name>.rs` with `pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk)` and
@@ -47,7 +47,7 @@ use crate::terrain::Pipeline;
 pub use chunk::{PassTiming, CHUNK};
 pub use columns::Columns;
 pub use context::ChunkContext;
-pub use light::SkyLight;
+pub use light::Light;
 pub use palette::{vanilla_biome_names, BiomePalette};
 pub use plants::is_plant;
 pub use surface::{Ground, Site};

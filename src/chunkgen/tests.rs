@@ -414,7 +414,7 @@ fn plains_grow_grass_and_flowers_and_plants_let_the_sky_light_through() {
     let (mut grass, mut flowers) = (0, 0);
     for (cx, cz) in land_chunks(&g, &rules, 2) {
         let chunk = g.chunk(&rules, &palette, cx, cz);
-        let light = SkyLight::of(&chunk);
+        let light = Light::of(&chunk);
         for lz in 0..16u32 {
             for lx in 0..16u32 {
                 let seen = plant_on(&chunk, &v, lx, lz);
@@ -431,7 +431,7 @@ fn plains_grow_grass_and_flowers_and_plants_let_the_sky_light_through() {
                     let above = (ground_y + 1 - v.min_y) as u32;
                     let covered = (above..chunk.height()).any(|y| is_tree(chunk.block_state(lx, y, lz)));
                     if !covered {
-                        assert_eq!(light.get(lx, above, lz), 15, "a plant shades ({lx}, {lz}) of ({cx}, {cz})");
+                        assert_eq!(light.sky(lx, above, lz), 15, "a plant shades ({lx}, {lz}) of ({cx}, {cz})");
                     }
                 }
             }

@@ -48,7 +48,7 @@ fn reshape_dimension(setup: Res<WorldSetup>, mut dimensions: ResMut<DimensionTyp
     dim.height = w.height as i32;
     dim.logical_height = w.height as i32;
     // valence forces full-bright ambient light because it sends no light; the server sends
-    // sky light itself (see `chunkgen::SkyLight`), so the night and the deep sea can be dark.
+    // sky light itself (see `chunkgen::Light`), so the night and the deep sea can be dark.
     dim.ambient_light = 0.0;
 }
 

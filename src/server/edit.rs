@@ -21,7 +21,7 @@ use valence::protocol::{CompressionThreshold, PacketEncoder};
 
 use super::dimension::{Palette, WorldSetup};
 use super::stream::Streamer;
-use crate::chunkgen::SkyLight;
+use crate::chunkgen::Light;
 use crate::world::codec::Encoder;
 use crate::world::Store;
 
@@ -127,7 +127,7 @@ fn save_edited(
     for pos in edited.0.drain() {
         let Some(loaded) = layer.chunk(pos) else { continue };
         let chunk = snapshot(loaded);
-        let light = SkyLight::of(&chunk);
+        let light = Light::of(&chunk);
         let mut encoder = PacketEncoder::new();
         encoder.set_compression(saver.compression);
         match encoder.append_packet(&light.packet(pos)) {

@@ -9,7 +9,7 @@ use valence::prelude::UnloadedChunk;
 use super::codec::{Decoder, Encoder};
 use super::store::{Store, StoreError};
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, SkyLight};
+use crate::chunkgen::{BiomePalette, Generator, Light};
 
 /// Where a chunk came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -64,17 +64,17 @@ impl ChunkSource {
     /// generated with `rules` and queued for saving. A chunk that cannot be saved (a full
     /// disk) is still returned, so players keep playing; the error is logged and recorded in
     /// the store.
-    pub fn get(&self, scratch: &mut Scratch, rules: &BiomeRules, x: i32, z: i32) -> (UnloadedChunk, SkyLight, Origin) {
+    pub fn get(&self, scratch: &mut Scratch, rules: &BiomeRules, x: i32, z: i32) -> (UnloadedChunk, Light, Origin) {
         let Some(store) = &self.store else {
             let chunk = self.generator.chunk(rules, &self.palette, x, z);
-            let light = SkyLight::of(&chunk);
+            let light = Light::of(&chunk);
             return (chunk, light, Origin::Generated);
         };
         let origin = match store.load(x, z) {
             Ok(None) => Origin::Generated,
             Ok(Some(nbt)) => match scratch.decoder.decode(x, z, &nbt) {
                 Ok(chunk) => {
-                    let light = SkyLight::of(&chunk);
+                    let light = Light::of(&chunk);
                     return (chunk, light, Origin::Loaded);
                 }
                 Err(e) => Origin::Regenerated(format!("chunk {x}, {z} in {}: {e}", self.region_file(x, z))),
@@ -82,7 +82,7 @@ impl ChunkSource {
             Err(e) => Origin::Regenerated(e.to_string()),
         };
         let chunk = self.generator.chunk(rules, &self.palette, x, z);
-        let light = SkyLight::of(&chunk);
+        let light = Light::of(&chunk);
         let nbt = scratch.encoder.encode(x, z, &chunk, &light);
         if let Err(e) = store.save(x, z, &nbt) {
             tracing::error!("{e}");
@@ -99,7 +99,7 @@ impl ChunkSource {
             return Ok(false);
         }
         let chunk = self.generator.chunk(rules, &self.palette, x, z);
-        let light = SkyLight::of(&chunk);
+        let light = Light::of(&chunk);
         let nbt = scratch.encoder.encode(x, z, &chunk, &light);
         store.save(x, z, &nbt)?;
         Ok(true)

@@ -11,7 +11,7 @@ use std::sync::Arc;
 #[allow(unused_imports)]
 pub use infiniterra::{
     biome::BiomeRules,
-    chunkgen::{BiomePalette, Generator, SkyLight},
+    chunkgen::{BiomePalette, Generator, Light},
     config::Config,
     terrain::Pipeline,
     world::find_spawn,

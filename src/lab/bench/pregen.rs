@@ -8,7 +8,7 @@ use valence::prelude::{ChunkPos, ChunkView};
 
 use super::Measurement;
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, SkyLight};
+use crate::chunkgen::{BiomePalette, Generator, Light};
 use crate::config::Config;
 use crate::pregen::{run_to_end, Hooks, Job, Plan, Shape, Shard, Task};
 use crate::terrain::Pipeline;
@@ -123,7 +123,7 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
             passes[i].1 += timing.nanos as f64 * 1e-9;
         }
         let t = Instant::now();
-        let sky = SkyLight::of(&chunk);
+        let sky = Light::of(&chunk);
         light += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let nbt = encoder.encode(x, z, &chunk, &sky);
@@ -137,7 +137,7 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     for (name, seconds) in passes {
         out.push(Measurement::new(&format!("  of which the {name} pass"), "ms", per(seconds)));
     }
-    out.push(Measurement::new("per chunk, 1 thread: sky light", "ms", per(light)));
+    out.push(Measurement::new("per chunk, 1 thread: light (sky and block)", "ms", per(light)));
     out.push(Measurement::new("per chunk, 1 thread: NBT encoding", "ms", per(encode)));
     out.push(Measurement::new("per chunk, 1 thread: zlib compression", "ms", per(compress)));
 

@@ -6,7 +6,7 @@ use valence::registry::RegistryIdx;
 
 use super::nbt::{bit_width, tag, Writer};
 use super::{BLOCKS, CELLS, DATA_VERSION};
-use crate::chunkgen::SkyLight;
+use crate::chunkgen::Light;
 
 /// Marks a block state that has no palette entry in the section being encoded.
 const NO_SLOT: u16 = u16::MAX;
@@ -54,14 +54,14 @@ impl Encoder {
     /// writes a finished chunk: `DataVersion`, `xPos`, `zPos`, `yPos`, `Status`
     /// `"minecraft:full"`, `LastUpdate` and `InhabitedTime` 0 (nothing time-varying: the same
     /// chunk always encodes to the same bytes), `isLightOn`, `sections` (block states, biomes
-    /// and sky light; plus the light-only sections just below and above the world when they
+    /// and sky and block light; plus the light-only sections just below and above the world when they
     /// have any light, as vanilla writes them), empty `block_entities` and `structures`.
     /// `Heightmaps` are left out: Minecraft computes missing ones when it loads the chunk.
     ///
     /// Panics when `light` is not the light of a chunk as high as `chunk`.
-    pub fn encode(&mut self, chunk_x: i32, chunk_z: i32, chunk: &UnloadedChunk, light: &SkyLight) -> Vec<u8> {
+    pub fn encode(&mut self, chunk_x: i32, chunk_z: i32, chunk: &UnloadedChunk, light: &Light) -> Vec<u8> {
         let sections = (chunk.height() / 16) as usize;
-        assert_eq!(light.section_count(), sections + 2, "sky light of a chunk of another height");
+        assert_eq!(light.section_count(), sections + 2, "light of a chunk of another height");
         let min_section = self.min_y.div_euclid(16);
         let mut w = Writer(Vec::with_capacity(self.last_len + self.last_len / 8));
         w.tag(tag::COMPOUND, "");
@@ -75,8 +75,9 @@ impl Encoder {
         w.byte("isLightOn", 1);
 
         // Light-only sections are written only when they carry light, so count first.
-        let below = light.section_bytes(0);
-        let above = light.section_bytes(sections + 1);
+        // (Nothing glows outside the world, so those two carry sky light only.)
+        let below = light.sky_bytes(0);
+        let above = light.sky_bytes(sections + 1);
         let count = sections + usize::from(below.is_some()) + usize::from(above.is_some());
         w.list("sections", tag::COMPOUND, count);
         if let Some(bytes) = below {
@@ -88,8 +89,11 @@ impl Encoder {
             w.byte("Y", (min_section + s as i32) as i8);
             self.block_states(&mut w, chunk, s as u32);
             self.biomes(&mut w, chunk, s as u32);
-            if let Some(bytes) = light.section_bytes(s + 1) {
+            if let Some(bytes) = light.sky_bytes(s + 1) {
                 w.byte_array("SkyLight", bytes);
+            }
+            if let Some(bytes) = light.block_bytes(s + 1) {
+                w.byte_array("BlockLight", bytes);
             }
             w.end();
         }

@@ -11,7 +11,7 @@ use valence::registry::RegistryIdx;
 use super::nbt::{bit_width, packed_len};
 use super::*;
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, SkyLight};
+use crate::chunkgen::{BiomePalette, Generator, Light};
 use crate::config::Config;
 use crate::terrain::Pipeline;
 
@@ -31,7 +31,7 @@ fn decoder() -> Decoder {
 }
 
 fn encode(chunk: &UnloadedChunk, x: i32, z: i32) -> Vec<u8> {
-    encoder().encode(x, z, chunk, &SkyLight::of(chunk))
+    encoder().encode(x, z, chunk, &Light::of(chunk))
 }
 
 fn parse(bytes: &[u8]) -> Compound {
@@ -164,7 +164,7 @@ fn a_varied_chunk_round_trips() {
 #[test]
 fn the_header_and_light_are_as_vanilla_writes_them() {
     let chunk = varied_chunk();
-    let light = SkyLight::of(&chunk);
+    let light = Light::of(&chunk);
     let mut root = parse(&encoder().encode(3, -7, &chunk, &light));
     assert_eq!(root.get("DataVersion"), Some(&Value::Int(3465)));
     assert_eq!(root.get("xPos"), Some(&Value::Int(3)));
@@ -177,7 +177,7 @@ fn the_header_and_light_are_as_vanilla_writes_them() {
     // Below the world is dark (no section); above it is open sky.
     assert_eq!(ys, (-4..=20).map(|y| Some(Value::Byte(y))).collect::<Vec<_>>());
     for (i, s) in sections(&mut root).iter().enumerate() {
-        let expected = light.section_bytes(i + 1).map(|b| b.iter().map(|&v| v as i8).collect::<Vec<_>>());
+        let expected = light.sky_bytes(i + 1).map(|b| b.iter().map(|&v| v as i8).collect::<Vec<_>>());
         let found = match s.get("SkyLight") {
             Some(Value::ByteArray(b)) => Some(b.clone()),
             None => None,
@@ -187,6 +187,15 @@ fn the_header_and_light_are_as_vanilla_writes_them() {
     }
     assert!(section(&mut root, 20).get("block_states").is_none(), "the section above holds light only");
     assert!(section(&mut root, -4).get("SkyLight").is_none(), "the floor section is dark");
+    assert!(sections(&mut root).iter().all(|s| s.get("BlockLight").is_none()), "nothing glows");
+    // Block light where something does: lava at chunk-local Y 20, section Y −3.
+    let mut glowing = varied_chunk();
+    glowing.set_block_state(4, 20, 4, BlockState::LAVA);
+    let light = Light::of(&glowing);
+    let mut root = parse(&encoder().encode(3, -7, &glowing, &light));
+    let lit: Vec<i8> = light.block_bytes(2).expect("the lava's section is lit").iter().map(|&v| v as i8).collect();
+    assert_eq!(section(&mut root, -3).get("BlockLight"), Some(&Value::ByteArray(lit)));
+    assert!(section(&mut root, 0).get("BlockLight").is_none());
 }
 
 #[test]
@@ -317,11 +326,10 @@ fn every_block_state_round_trips() {
 #[test]
 fn the_same_chunk_encodes_to_the_same_bytes() {
     let chunk = varied_chunk();
-    let light = SkyLight::of(&chunk);
+    let light = Light::of(&chunk);
     let mut reused = encoder();
     let first = reused.encode(1, 2, &chunk, &light);
-    let _other =
-        reused.encode(0, 0, &palette_chunk(&[300, 5], &[7]), &SkyLight::of(&UnloadedChunk::with_height(HEIGHT)));
+    let _other = reused.encode(0, 0, &palette_chunk(&[300, 5], &[7]), &Light::of(&UnloadedChunk::with_height(HEIGHT)));
     assert_eq!(first, reused.encode(1, 2, &chunk, &light), "a reused encoder");
     assert_eq!(first, encoder().encode(1, 2, &chunk, &light), "a fresh encoder");
 }
@@ -430,7 +438,7 @@ fn generated_chunks_round_trip() {
     let decoder = decoder();
     let chunks: Vec<_> =
         [(0, 0), (7, -3), (-20, 11)].iter().map(|&(x, z)| (x, z, g.chunk(&rules, &palette, x, z))).collect();
-    let lights: Vec<_> = chunks.iter().map(|(_, _, c)| SkyLight::of(c)).collect();
+    let lights: Vec<_> = chunks.iter().map(|(_, _, c)| Light::of(c)).collect();
     let rounds = 20;
     let start = Instant::now();
     let mut bytes = Vec::new();
