@@ -12,6 +12,7 @@ use crate::biome::BiomeRules;
 use crate::terrain::pipeline::channel;
 use crate::terrain::Rect;
 
+use super::cave_field;
 use super::cells::{self, CELL};
 use super::columns::Columns;
 use super::plants::{self, Plant};
@@ -43,7 +44,10 @@ impl Generator {
         let v = &self.vertical;
         let candidate = |x: i64, z: i64| -> Option<(i32, Plant)> {
             let ground_y = columns.surface_y(x, z);
-            if columns.is_wet(x, z) || columns.drop_blocks(x, z) >= surface::STEEP_DROP_BLOCKS {
+            if columns.is_wet(x, z)
+                || columns.drop_blocks(x, z) >= surface::STEEP_DROP_BLOCKS
+                || cave_field::may_open(self.seed, columns, x, z)
+            {
                 return None;
             }
             let biome = self.surface_biome(rules, columns, x, z);
@@ -94,7 +98,9 @@ impl Generator {
             let ground_y = columns.surface_y(x, z);
             let ground = self.ground_at(columns, biome, x, z);
             let dry = !columns.is_wet(x, z) && !ground.top.is_liquid();
-            if dry && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top) {
+            let rooted = !cave_field::may_open(self.seed, columns, x, z);
+            if dry && rooted && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top)
+            {
                 let tree = Tree::new(self.seed, x, z, ground_y, kind);
                 if tree.top_y() < v.min_y + v.height {
                     trees.push(tree);

@@ -25,6 +25,7 @@
 //!
 //! [`UnloadedChunk`]: valence::prelude::UnloadedChunk
 
+mod cave_field;
 mod cells;
 mod chunk;
 mod column;

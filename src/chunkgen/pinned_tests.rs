@@ -117,15 +117,15 @@ fn hash_biomes(chunk: &UnloadedChunk, h: &mut Fnv) {
 const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
-/// world with the shipped biome rules) outside the shallow sea, re-recorded with the
-/// continent's drainage, ragged bedrock and deepslate, and mangrove roots.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0x7cd5_ccc4_2d5d_3877;
+/// world with the shipped biome rules) outside the shallow sea, re-recorded with cave
+/// mouths (caves carved up to the ground in entrance patches, left open by the surface).
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xd42a_7b68_6ef6_babf;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded as above.
-const PROCEDURAL_HASH: u64 = 0xff1c_dc6d_7bf2_61fe;
+const PROCEDURAL_HASH: u64 = 0x2af3_1f43_02a4_959b;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]
-const LEARNED_HASH: u64 = 0xbc52_d38a_6ca9_1853;
+const LEARNED_HASH: u64 = 0x4c18_7d15_e457_3b76;
 
 fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();

@@ -1,80 +1,30 @@
-//! The caves pass: carves caverns ("cheese") and winding tunnels ("spaghetti") out of the
-//! rock, as vanilla 1.18+ does with density noise, and floods what it carves at Y −55 and
-//! below with lava (vanilla's lava level).
-//!
-//! The cave field is a density sampled on a lattice of 4 × 8 × 4 blocks and interpolated
-//! trilinearly between (vanilla samples its noise the same way): caverns where a two-octave
-//! noise is high, tunnels where two independent noises are both near their middle (the
-//! intersection of two surfaces is a line). A pure function of (seed, x, y, z), so caves run
-//! on across chunk borders.
-//!
-//! Caves stay dry: no cave reaches within [`SEA_SEAL`] blocks of the ground under the sea or
-//! near it (a cave opening under water would flood in vanilla the moment a block next to it
-//! is touched), and nothing is carved within [`LAND_SEAL`] blocks of the ground elsewhere, so
-//! the surface pass's ground stays whole.
+//! The caves pass: carves the cave field ([`crate::chunkgen::cave_field`]: caverns and
+//! winding tunnels from density noise, as vanilla 1.18+ does) out of the rock, and floods
+//! what it carves at Y −55 and below with lava (vanilla's lava level). Each column is carved
+//! up to its ceiling: under the ground, clear of water, or through the ground in entrance
+//! patches (cave mouths).
 
 use valence::prelude::{BlockState, Chunk, UnloadedChunk};
 
-use crate::chunkgen::hash::value_noise3;
+use crate::chunkgen::cave_field::{ceiling, density, interpolate, widening, LATTICE, LATTICE_Y, MOUTH_DEPTH};
 use crate::chunkgen::{ChunkContext, CHUNK};
 
-/// Lattice spacing of the cave density across, blocks.
-const LATTICE: i64 = 4;
-/// Lattice spacing of the cave density up and down, blocks (vanilla's noise cells are
-/// 4 × 8 × 4 too; caves are flatter than they are wide).
-const LATTICE_Y: i64 = 8;
-/// Blocks of rock kept between a cave and the ground of a sea column, or of any column within
-/// [`SHORE_REACH`] blocks of one.
-pub const SEA_SEAL: i32 = 8;
-/// Blocks of rock kept between a cave and the ground of dry land.
-pub const LAND_SEAL: i32 = 4;
-/// How far from the sea (blocks) the sea's seal still applies.
-const SHORE_REACH: i64 = 3;
 /// Carved blocks at this Y and below are lava.
 pub const LAVA_Y: i32 = -55;
 /// Blocks above the floor that are never carved (the bedrock and a layer over it).
 const FLOOR_KEEP: i32 = 5;
-/// Cavern threshold on the cavern noise (0..1): higher, rarer caverns.
-const CAVERN_AT: f32 = 0.74;
-/// Half-width of a tunnel in noise units around each noise's middle.
-const TUNNEL_HALF_WIDTH: f32 = 0.045;
-
-/// The cave density at a block (> 0: carved).
-pub fn density(seed: u64, x: i64, y: i64, z: i64) -> f32 {
-    let (fx, fy, fz) = (x as f64, y as f64, z as f64);
-    // Caverns: broad, flattened (vanilla's are wider than tall).
-    let cavern = 0.7 * value_noise3(seed, 0xCA7E, fx / 48.0, fy / 24.0, fz / 48.0)
-        + 0.3 * value_noise3(seed, 0xCA7F, fx / 16.0, fy / 8.0, fz / 16.0);
-    // Tunnels: where two noises are both near one half.
-    let a = value_noise3(seed, 0x5A6E, fx / 36.0, fy / 18.0, fz / 36.0) - 0.5;
-    let b = value_noise3(seed, 0x5A6F, fx / 36.0, fy / 18.0, fz / 36.0) - 0.5;
-    let tunnel = TUNNEL_HALF_WIDTH - a.abs().max(b.abs());
-    (cavern - CAVERN_AT).max(tunnel)
-}
 
 /// Carves the chunk's caves (air, lava at [`LAVA_Y`] and below).
 pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     let v = *ctx.vertical();
     let columns = ctx.columns();
     // The highest Y each column may be carved to.
-    let ceiling: Vec<i32> = ctx
-        .each_column()
-        .map(|(_, _, x, z)| {
-            let near_sea = (-SHORE_REACH..=SHORE_REACH)
-                .any(|dz| (-SHORE_REACH..=SHORE_REACH).any(|dx| columns.is_wet(x + dx, z + dz)));
-            let ground = columns.surface_y(x, z);
-            if near_sea {
-                let lowest = (-SHORE_REACH..=SHORE_REACH)
-                    .flat_map(|dz| (-SHORE_REACH..=SHORE_REACH).map(move |dx| (dx, dz)))
-                    .map(|(dx, dz)| columns.surface_y(x + dx, z + dz))
-                    .min()
-                    .unwrap_or(ground);
-                lowest - SEA_SEAL
-            } else {
-                ground - LAND_SEAL
-            }
-        })
-        .collect();
+    let seed = ctx.seed();
+    let ceiling: Vec<i32> = ctx.each_column().map(|(_, _, x, z)| ceiling(seed, columns, x, z)).collect();
+    // Entrance patches widen the caves near the ground: from this Y up, by this much.
+    let mouths: Vec<(i32, f32)> =
+        ctx.each_column().map(|(_, _, x, z)| (columns.surface_y(x, z) - MOUTH_DEPTH, widening(seed, x, z))).collect();
+    let widest = mouths.iter().map(|m| m.1).fold(0.0, f32::max);
     let top = ceiling.iter().copied().max().unwrap_or(v.min_y);
     let bottom = v.min_y + FLOOR_KEEP;
     if top < bottom {
@@ -85,7 +35,6 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     let (ly0, ly1) = ((bottom as i64).div_euclid(LATTICE_Y), (top as i64).div_euclid(LATTICE_Y) + 1);
     let n = (CHUNK / LATTICE + 1) as usize;
     let rows = (ly1 - ly0 + 1) as usize;
-    let seed = ctx.seed();
     let mut lattice = vec![0f32; n * n * rows];
     for (j, ly) in (ly0..=ly1).enumerate() {
         for k in 0..n {
@@ -110,24 +59,34 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                     at(i, j + 1, k + 1),
                     at(i + 1, j + 1, k + 1),
                 ];
-                // Trilinear values stay within the corners': a cell with no positive corner
-                // has no cave (most of the rock), so it is skipped whole.
-                if corners.iter().all(|&d| d <= 0.0) {
+                // Trilinear values stay within the corners': a cell with no corner positive
+                // even when widened has no cave (most of the rock), so it is skipped whole.
+                if corners.iter().all(|&d| d + widest <= 0.0) {
                     continue;
                 }
-                carve_cell(chunk, &corners, (i, j, k), ly0, &ceiling, bottom, v.min_y);
+                let columns = Carve { ceiling: &ceiling, mouths: &mouths };
+                carve_cell(chunk, &corners, (i, j, k), ly0, &columns, bottom, v.min_y);
             }
         }
     }
 }
 
-/// Carves the blocks of one lattice cell whose interpolated density is positive.
+/// What limits and widens the carving of each column of the chunk (index `z·16 + x`).
+struct Carve<'a> {
+    /// The highest Y carved.
+    ceiling: &'a [i32],
+    /// From which Y up the density is raised, and by how much (an entrance patch).
+    mouths: &'a [(i32, f32)],
+}
+
+/// Carves the blocks of one lattice cell whose interpolated density (widened in entrance
+/// patches) is positive.
 fn carve_cell(
     chunk: &mut UnloadedChunk,
     c: &[f32; 8],
     (i, j, k): (usize, usize, usize),
     ly0: i64,
-    ceiling: &[i32],
+    columns: &Carve,
     bottom: i32,
     min_y: i32,
 ) {
@@ -143,14 +102,13 @@ fn carve_cell(
             let tz = dz as f32 / LATTICE as f32;
             for dx in 0..l {
                 let tx = dx as f32 / LATTICE as f32;
-                let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-                let low = lerp(lerp(c[0], c[1], tx), lerp(c[2], c[3], tx), tz);
-                let high = lerp(lerp(c[4], c[5], tx), lerp(c[6], c[7], tx), tz);
-                if lerp(low, high, ty) <= 0.0 {
+                let (lx, lz) = (i * l + dx, k * l + dz);
+                let column = lz * CHUNK as usize + lx;
+                let (from, widen) = columns.mouths[column];
+                if interpolate(c, tx, ty, tz) + if y >= from { widen } else { 0.0 } <= 0.0 {
                     continue;
                 }
-                let (lx, lz) = (i * l + dx, k * l + dz);
-                if y > ceiling[lz * CHUNK as usize + lx] {
+                if y > columns.ceiling[column] {
                     continue;
                 }
                 let block = if y <= LAVA_Y { BlockState::LAVA } else { BlockState::AIR };
@@ -167,6 +125,7 @@ fn carve_cell(
 mod tests {
     use super::super::testing;
     use super::*;
+    use crate::chunkgen::cave_field::{entrance, field, opens, LAND_SEAL};
     use crate::terrain::Rect;
 
     /// A chunk of rock up to `ground(x)` with the sea pass run, then this pass.
@@ -185,6 +144,7 @@ mod tests {
 
     #[test]
     fn land_has_caves_with_lava_only_deep_down_and_a_sealed_ground() {
+        let seed = testing::generator().seed;
         let (mut air, mut lava) = (0, 0);
         for cx in 0..6 {
             // Ground at 1,000 m: Y 103.
@@ -195,7 +155,9 @@ mod tests {
                         let b = chunk.block_state(x, (y - v.min_y) as u32, z);
                         if y <= 103 && b.is_air() {
                             air += 1;
-                            assert!(y > LAVA_Y && y <= 103 - LAND_SEAL && y >= v.min_y + FLOOR_KEEP, "air at Y {y}");
+                            let (gx, gz) = (i64::from(cx) * 16 + i64::from(x), 48 + i64::from(z));
+                            let sealed = y <= 103 - LAND_SEAL || entrance(seed, gx, gz);
+                            assert!(y > LAVA_Y && sealed && y >= v.min_y + FLOOR_KEEP, "air at Y {y}");
                         }
                         if b == BlockState::LAVA {
                             lava += 1;
@@ -241,21 +203,41 @@ mod tests {
     }
 
     #[test]
+    fn caves_open_through_the_ground_only_in_entrance_patches_where_the_field_says() {
+        // Flat land at 1,000 m (ground Y 103) over 8 × 8 chunks.
+        let g = testing::generator();
+        let (mut mouths, mut patch_columns) = (0, 0);
+        for cz in 0..8 {
+            for cx in 0..8 {
+                let (chunk, v) = carved((cx, cz), |_| 1000.0);
+                let columns =
+                    testing::columns(&g, Rect::new(i64::from(cz) * 16 - 4, i64::from(cx) * 16 - 4, 24, 24), |_, _| {
+                        (1000.0, 10.0)
+                    });
+                assert_eq!(columns.surface_y(i64::from(cx) * 16, i64::from(cz) * 16), 103);
+                for z in 0..16u32 {
+                    for x in 0..16u32 {
+                        let (gx, gz) = (i64::from(cx) * 16 + i64::from(x), i64::from(cz) * 16 + i64::from(z));
+                        let open = chunk.block_state(x, (103 - v.min_y) as u32, z).is_air();
+                        assert_eq!(open, opens(g.seed, &columns, gx, gz), "({gx}, {gz})");
+                        assert!(!open || entrance(g.seed, gx, gz));
+                        mouths += usize::from(open);
+                        patch_columns += usize::from(entrance(g.seed, gx, gz));
+                    }
+                }
+            }
+        }
+        let all = 64 * 256;
+        assert!(patch_columns > all / 50 && patch_columns < all / 4, "entrance patches: {patch_columns} of {all}");
+        // Measured: 59 open columns of 2,426 in patches (a mouth every few chunks).
+        assert!(mouths > 0 && mouths < patch_columns / 2, "{mouths} open columns in {patch_columns}");
+    }
+
+    #[test]
     fn neighbouring_chunks_carve_one_cave_field_without_seams() {
         // Each block is carved exactly where the density, interpolated from the lattice
         // points around it in global coordinates, is positive: the same in whichever chunk.
-        let g = testing::generator();
-        let seed = g.seed;
-        let interpolated = |x: i64, y: i64, z: i64| {
-            let (cx, cy, cz) = (x.div_euclid(LATTICE), y.div_euclid(LATTICE_Y), z.div_euclid(LATTICE));
-            let t = |v: i64| v.rem_euclid(LATTICE) as f32 / LATTICE as f32;
-            let ty = y.rem_euclid(LATTICE_Y) as f32 / LATTICE_Y as f32;
-            let d =
-                |i: i64, j: i64, k: i64| density(seed, (cx + i) * LATTICE, (cy + j) * LATTICE_Y, (cz + k) * LATTICE);
-            let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-            let plane = |j: i64| lerp(lerp(d(0, j, 0), d(1, j, 0), t(x)), lerp(d(0, j, 1), d(1, j, 1), t(x)), t(z));
-            lerp(plane(0), plane(1), ty)
-        };
+        let seed = testing::generator().seed;
         let mut carved_blocks = 0;
         for cx in [-1, 0] {
             let (chunk, v) = carved((cx, 0), |_| 1000.0);
@@ -264,7 +246,7 @@ mod tests {
                     for y in (-50..90).step_by(3) {
                         let gx = i64::from(cx) * 16 + i64::from(x);
                         let air = chunk.block_state(x, (y - v.min_y) as u32, z).is_air();
-                        assert_eq!(air, interpolated(gx, i64::from(y), i64::from(z)) > 0.0, "({gx}, {y}, {z})");
+                        assert_eq!(air, field(seed, gx, i64::from(y), i64::from(z)) > 0.0, "({gx}, {y}, {z})");
                         carved_blocks += usize::from(air);
                     }
                 }

@@ -4,6 +4,7 @@
 
 use valence::prelude::{Chunk, UnloadedChunk};
 
+use crate::chunkgen::cave_field;
 use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::surface::terracotta_band;
 use crate::chunkgen::ChunkContext;
@@ -20,6 +21,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
         let cell_y = ((cells::cell_centre_y(surface_y) - v.min_y) / CELL as i32) as usize;
         let cell = ((lz as i64 / CELL) * 4 + lx as i64 / CELL) as usize;
         let ground = ctx.generator.ground_at(columns, ctx.biomes[cell * cells_y + cell_y], x, z);
+        let mouth = cave_field::may_open(ctx.seed(), columns, x, z);
         // The rock pass filled whole sections only this far below the lowest ground.
         debug_assert!(ground.filler_depth < MAX_GROUND_DEPTH);
         for y in (surface_y - ground.filler_depth).max(v.min_y + 1)..=surface_y {
@@ -30,7 +32,11 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
             } else {
                 ground.filler
             };
-            chunk.set_block_state(lx, (y - v.min_y) as u32, lz, block);
+            let ly = (y - v.min_y) as u32;
+            // A cave's mouth stays open (elsewhere the ground is whole: caves keep under it).
+            if !(mouth && chunk.block_state(lx, ly, lz).is_air()) {
+                chunk.set_block_state(lx, ly, lz, block);
+            }
         }
     }
 }
