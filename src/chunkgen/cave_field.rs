@@ -114,9 +114,7 @@ pub fn ceiling(seed: u64, columns: &Columns, x: i64, z: i64) -> i32 {
 }
 
 /// True where the caves pass carves column (`x`, `z`)'s ground block away: a cave's mouth.
-/// `columns` must hold the column's neighbours within [`SHORE_REACH`]. (Generation asks
-/// [`may_open`]; tests check the pass against this.)
-#[cfg(test)]
+/// `columns` must hold the column's neighbours within [`SHORE_REACH`].
 pub fn opens(seed: u64, columns: &Columns, x: i64, z: i64) -> bool {
     may_open(seed, columns, x, z) && ceiling(seed, columns, x, z) >= columns.surface_y(x, z)
 }

@@ -122,15 +122,21 @@ impl Generator {
     /// with this).
     pub fn surface(&self, rules: &BiomeRules, x: i64, z: i64) -> SurfaceSample {
         let (cell_x, cell_z) = (x.div_euclid(CELL), z.div_euclid(CELL));
+        // The cell and the columns a cave mouth's test looks at around it.
+        let m = 1 + cave_field::SHORE_REACH;
         let columns = Columns::query(
             &self.pipeline,
             &self.vertical,
-            Rect::new(cell_z * CELL - 1, cell_x * CELL - 1, CELL + 2, CELL + 2),
+            Rect::new(cell_z * CELL - m, cell_x * CELL - m, CELL + 2 * m, CELL + 2 * m),
         );
         let y = columns.surface_y(x, z);
         let biome = self.surface_biome(rules, &columns, x, z);
-        let top = self.ground_at(&columns, biome, x, z).top;
-        SurfaceSample { y, biome: biome.to_string(), top: top.to_kind().to_str(), water_y: columns.water_top_y(x, z) }
+        let top = if cave_field::opens(self.seed, &columns, x, z) {
+            "air"
+        } else {
+            self.ground_at(&columns, biome, x, z).top.to_kind().to_str()
+        };
+        SurfaceSample { y, biome: biome.to_string(), top, water_y: columns.water_top_y(x, z) }
     }
 
     /// The surface of every column of `rect` (row-major: z rows, x within a row), each exactly

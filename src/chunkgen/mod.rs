@@ -96,7 +96,8 @@ pub struct SurfaceSample {
     pub y: i32,
     /// Biome of the cell holding that block (`"minecraft:plains"`).
     pub biome: String,
-    /// Name of the ground block there (`"grass_block"`), before any vegetation or sea ice.
+    /// Name of the ground block there (`"grass_block"`), before any vegetation or sea ice;
+    /// `"air"` where a cave's mouth has carved it away.
     pub top: &'static str,
     /// Block Y of the top of the water over the column (sea, river or lake), if any.
     pub water_y: Option<i32>,

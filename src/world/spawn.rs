@@ -67,7 +67,7 @@ fn walkable_column(generator: &Generator, rules: &BiomeRules, x0: i64, z0: i64, 
     // The exact top block needs the biome; only a few columns are ever looked at.
     candidates.into_iter().take(CHUNK as usize).find_map(|(x, z)| {
         let surface = generator.surface(rules, x, z);
-        let solid = !matches!(surface.top, "powder_snow" | "water" | "ice");
+        let solid = !matches!(surface.top, "powder_snow" | "water" | "ice" | "air");
         // Grass and flowers are walked through; a cactus is not a place to stand.
         let no_cactus = !generator.plant_blocks(rules, x, z).contains(&BlockState::CACTUS);
         (solid && no_cactus && generator.clear_of_trees(rules, x, z)).then(|| at(x, surface.y, z))
