@@ -17,7 +17,7 @@ use std::sync::Arc;
 
 pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 
-use crate::climate::{precipitation, temperature_at, Orographic};
+use crate::climate::{precipitation, temperature_at, Orographic, OrographicSweep};
 use crate::encoding::box_downsample;
 use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
 use crate::hydrology::continental::Continental;
@@ -200,18 +200,16 @@ impl Pipeline {
         let coarse_elevation =
             ran.iter().rev().find(|g| g.metres == coarse_metres).map_or(sketch.source.clone(), |g| g.source.clone());
         let coarse_sketch: Arc<dyn Source> = Arc::new(layout.climate_sketch(coarse_metres));
-        let precipitation = Windowed::new(
-            &engine,
-            Orographic {
-                elevation: coarse_elevation.clone(),
-                sketch: coarse_sketch.clone(),
-                settings: settings.climate.clone(),
-                pixel_metres: coarse_metres,
-                layout: WindowLayout::square(32, 16, 0),
-                // Rain shadows fade over ~500 km of land: keep ~400 km of upwind history.
-                margin: 48,
-            },
-        );
+        let orographic = || Orographic {
+            elevation: coarse_elevation.clone(),
+            sketch: coarse_sketch.clone(),
+            settings: settings.climate.clone(),
+            pixel_metres: coarse_metres,
+            layout: WindowLayout::square(32, 16, 0),
+            // Rain shadows fade over ~500 km of land: keep ~400 km of upwind history.
+            margin: 48,
+        };
+        let precipitation = Windowed::new(&engine, orographic());
         // The model grid carries the finest stage that ran (the layout's 500 m grid when none
         // did), resampled to it, with the erosion filter's octaves the grid can hold.
         let base = ran.pop().unwrap_or_else(|| StageGrid::layout(Arc::new(layout.elevation(BASE_METRES)), BASE_METRES));
@@ -226,13 +224,14 @@ impl Pipeline {
             temperature_offset_c: settings.climate.temperature_offset_c as f32,
             lapse_c_per_km: settings.climate.lapse_rate_c_per_km as f32,
         };
-        let continental: Arc<dyn Source> = Windowed::new(
-            &engine,
-            Continental {
-                inputs: Arc::new(inputs(coarse_elevation.clone(), coarse_metres, coarse_metres)),
-                cell_metres: coarse_metres,
-            },
-        );
+        // The continent's rain comes from one sweep over each tile's whole window (see
+        // `OrographicSweep`), not from the windowed tensor the network reads.
+        let continental_inputs = NetworkInputs {
+            precipitation: Arc::new(OrographicSweep(orographic())),
+            ..inputs(coarse_elevation.clone(), coarse_metres, coarse_metres)
+        };
+        let continental: Arc<dyn Source> =
+            Windowed::new(&engine, Continental { inputs: Arc::new(continental_inputs), cell_metres: coarse_metres });
         let basins = Windowed::new(
             &engine,
             Basins {
