@@ -46,6 +46,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     }
     let at = |i: usize, j: usize, k: usize| lattice[(j * n + k) * n + i];
     let cells = n - 1;
+    let columns = Carve { ceiling: &ceiling, mouths: &mouths };
     for j in 0..rows - 1 {
         for k in 0..cells {
             for i in 0..cells {
@@ -64,7 +65,6 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                 if corners.iter().all(|&d| d + widest <= 0.0) {
                     continue;
                 }
-                let columns = Carve { ceiling: &ceiling, mouths: &mouths };
                 carve_cell(chunk, &corners, (i, j, k), ly0, &columns, bottom, v.min_y);
             }
         }
