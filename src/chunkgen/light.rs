@@ -15,7 +15,9 @@
 use std::collections::VecDeque;
 use std::sync::OnceLock;
 
-use valence::prelude::{BlockState, Chunk, ChunkPos, UnloadedChunk};
+use valence::prelude::{BlockState, ChunkPos, UnloadedChunk};
+
+use super::states::States;
 use valence::protocol::packets::play::LightUpdateS2c;
 use valence::protocol::{LengthPrefixedArray, VarInt};
 
@@ -50,24 +52,25 @@ fn index(x: u32, y: u32, z: u32) -> usize {
 impl Light {
     /// Computes the light of `chunk` from its blocks.
     pub fn of(chunk: &UnloadedChunk) -> Light {
-        let height = chunk.height();
+        Light::of_states(&States::of(chunk))
+    }
+
+    /// [`Light::of`] a chunk whose blocks were read already.
+    pub fn of_states(states: &States) -> Light {
+        let height = states.height();
         let n = height as usize * 256;
-        // Every block read once: what it takes away and what it gives off.
+        // Every block once: what it takes away and what it gives off.
         let table = properties();
         let mut damp = vec![0u8; n];
         let mut block = vec![0u8; n];
         let mut glowing = VecDeque::new();
-        for y in 0..height {
-            for z in 0..16u32 {
-                for x in 0..16u32 {
-                    let i = index(x, y, z);
-                    let p = table[usize::from(chunk.block_state(x, y, z).to_raw())];
-                    damp[i] = p & 0xF;
-                    if p >> 4 > 0 {
-                        block[i] = p >> 4;
-                        glowing.push_back((x, y, z));
-                    }
-                }
+        for (i, &id) in states.ids().iter().enumerate() {
+            let p = table[usize::from(id)];
+            damp[i] = p & 0xF;
+            if p >> 4 > 0 {
+                block[i] = p >> 4;
+                let i = i as u32;
+                glowing.push_back((i % 16, i / 256, i / 16 % 16));
             }
         }
 
@@ -285,6 +288,7 @@ fn properties() -> &'static [u8] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use valence::prelude::Chunk;
 
     fn column_chunk(blocks: &[(u32, BlockState)]) -> UnloadedChunk {
         let mut chunk = UnloadedChunk::with_height(64);

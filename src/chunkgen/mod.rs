@@ -36,6 +36,7 @@ mod light;
 mod palette;
 pub mod passes;
 mod plants;
+mod states;
 mod surface;
 mod trees;
 mod vertical;
@@ -51,6 +52,7 @@ pub use context::ChunkContext;
 pub use light::Light;
 pub use palette::{vanilla_biome_names, BiomePalette};
 pub use plants::is_plant;
+pub use states::States;
 pub use surface::{Ground, Site};
 pub use vertical::Vertical;
 

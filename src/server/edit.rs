@@ -21,7 +21,7 @@ use valence::protocol::{CompressionThreshold, PacketEncoder};
 
 use super::dimension::{Palette, WorldSetup};
 use super::stream::Streamer;
-use crate::chunkgen::Light;
+use crate::chunkgen::{Light, States};
 use crate::world::codec::Encoder;
 use crate::world::Store;
 
@@ -127,7 +127,8 @@ fn save_edited(
     for pos in edited.0.drain() {
         let Some(loaded) = layer.chunk(pos) else { continue };
         let chunk = snapshot(loaded);
-        let light = Light::of(&chunk);
+        let states = States::of(&chunk);
+        let light = Light::of_states(&states);
         let mut encoder = PacketEncoder::new();
         encoder.set_compression(saver.compression);
         match encoder.append_packet(&light.packet(pos)) {
@@ -140,7 +141,7 @@ fn save_edited(
             Err(e) => tracing::error!("light of edited chunk {}, {}: {e}", pos.x, pos.z),
         }
         if let Some(store) = saver.store.clone() {
-            let nbt = saver.encoder.encode(pos.x, pos.z, &chunk, &light);
+            let nbt = saver.encoder.encode_states(pos.x, pos.z, &chunk, &states, &light);
             if let Err(e) = store.save(pos.x, pos.z, &nbt) {
                 tracing::error!("saving edited chunk {}, {}: {e}", pos.x, pos.z);
                 say!("could not save the edit to chunk {}, {}: {e}", pos.x, pos.z);

@@ -9,7 +9,7 @@ use valence::prelude::UnloadedChunk;
 use super::codec::{Decoder, Encoder};
 use super::store::{Store, StoreError};
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, Light};
+use crate::chunkgen::{BiomePalette, Generator, Light, States};
 
 /// Where a chunk came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -82,8 +82,9 @@ impl ChunkSource {
             Err(e) => Origin::Regenerated(e.to_string()),
         };
         let chunk = self.generator.chunk(rules, &self.palette, x, z);
-        let light = Light::of(&chunk);
-        let nbt = scratch.encoder.encode(x, z, &chunk, &light);
+        let states = States::of(&chunk);
+        let light = Light::of_states(&states);
+        let nbt = scratch.encoder.encode_states(x, z, &chunk, &states, &light);
         if let Err(e) = store.save(x, z, &nbt) {
             tracing::error!("{e}");
         }
@@ -99,8 +100,9 @@ impl ChunkSource {
             return Ok(false);
         }
         let chunk = self.generator.chunk(rules, &self.palette, x, z);
-        let light = Light::of(&chunk);
-        let nbt = scratch.encoder.encode(x, z, &chunk, &light);
+        let states = States::of(&chunk);
+        let light = Light::of_states(&states);
+        let nbt = scratch.encoder.encode_states(x, z, &chunk, &states, &light);
         store.save(x, z, &nbt)?;
         Ok(true)
     }

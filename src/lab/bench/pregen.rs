@@ -8,7 +8,7 @@ use valence::prelude::{ChunkPos, ChunkView};
 
 use super::Measurement;
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, Light};
+use crate::chunkgen::{BiomePalette, Generator, Light, States};
 use crate::config::Config;
 use crate::pregen::{run_to_end, Hooks, Job, Plan, Shape, Shard, Task};
 use crate::terrain::Pipeline;
@@ -123,10 +123,12 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
             passes[i].1 += timing.nanos as f64 * 1e-9;
         }
         let t = Instant::now();
-        let sky = Light::of(&chunk);
+        // Reading the blocks counts with light, as the first to need them.
+        let states = States::of(&chunk);
+        let sky = Light::of_states(&states);
         light += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let nbt = encoder.encode(x, z, &chunk, &sky);
+        let nbt = encoder.encode_states(x, z, &chunk, &states, &sky);
         encode += t.elapsed().as_secs_f64();
         let t = Instant::now();
         std::hint::black_box(region::compress(&nbt));

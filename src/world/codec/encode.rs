@@ -6,7 +6,7 @@ use valence::registry::RegistryIdx;
 
 use super::nbt::{bit_width, tag, Writer};
 use super::{BLOCKS, CELLS, DATA_VERSION};
-use crate::chunkgen::Light;
+use crate::chunkgen::{Light, States};
 
 /// Marks a block state that has no palette entry in the section being encoded.
 const NO_SLOT: u16 = u16::MAX;
@@ -60,6 +60,18 @@ impl Encoder {
     ///
     /// Panics when `light` is not the light of a chunk as high as `chunk`.
     pub fn encode(&mut self, chunk_x: i32, chunk_z: i32, chunk: &UnloadedChunk, light: &Light) -> Vec<u8> {
+        self.encode_states(chunk_x, chunk_z, chunk, &States::of(chunk), light)
+    }
+
+    /// [`Encoder::encode`] with the chunk's blocks read already (`states`, of `chunk`).
+    pub fn encode_states(
+        &mut self,
+        chunk_x: i32,
+        chunk_z: i32,
+        chunk: &UnloadedChunk,
+        states: &States,
+        light: &Light,
+    ) -> Vec<u8> {
         let sections = (chunk.height() / 16) as usize;
         assert_eq!(light.section_count(), sections + 2, "light of a chunk of another height");
         let min_section = self.min_y.div_euclid(16);
@@ -87,7 +99,7 @@ impl Encoder {
         }
         for s in 0..sections {
             w.byte("Y", (min_section + s as i32) as i8);
-            self.block_states(&mut w, chunk, s as u32);
+            self.block_states(&mut w, states.section(s as u32));
             self.biomes(&mut w, chunk, s as u32);
             if let Some(bytes) = light.sky_bytes(s + 1) {
                 w.byte_array("SkyLight", bytes);
@@ -116,29 +128,22 @@ impl Encoder {
     }
 
     /// Writes the `block_states` compound of section `s`.
-    fn block_states(&mut self, w: &mut Writer, chunk: &UnloadedChunk, s: u32) {
+    fn block_states(&mut self, w: &mut Writer, section: &[u16]) {
         self.palette.clear();
         let mut last_raw = NO_SLOT; // No block state has this raw id.
         let mut last_slot = 0u16;
-        let mut i = 0;
-        for y in s * 16..s * 16 + 16 {
-            for z in 0..16 {
-                for x in 0..16 {
-                    let raw = chunk.block_state(x, y, z).to_raw();
-                    // Neighbouring blocks are mostly the same: skip the table then.
-                    if raw != last_raw {
-                        last_raw = raw;
-                        last_slot = self.slots[usize::from(raw)];
-                        if last_slot == NO_SLOT {
-                            last_slot = self.palette.len() as u16;
-                            self.slots[usize::from(raw)] = last_slot;
-                            self.palette.push(raw);
-                        }
-                    }
-                    self.indices[i] = last_slot;
-                    i += 1;
+        for (index, &raw) in self.indices.iter_mut().zip(section) {
+            // Neighbouring blocks are mostly the same: skip the table then.
+            if raw != last_raw {
+                last_raw = raw;
+                last_slot = self.slots[usize::from(raw)];
+                if last_slot == NO_SLOT {
+                    last_slot = self.palette.len() as u16;
+                    self.slots[usize::from(raw)] = last_slot;
+                    self.palette.push(raw);
                 }
             }
+            *index = last_slot;
         }
 
         w.tag(tag::COMPOUND, "block_states");

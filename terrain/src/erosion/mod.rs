@@ -25,6 +25,8 @@ mod tests;
 use std::f64::consts::TAU;
 use std::ops::Range;
 
+use crate::noise::{floor, sin_cos_turns};
+
 /// Wavelength of the longest octave, metres: the band the 1 km learned grid only half
 /// resolves (its cubic resampling keeps little below ~3 km).
 pub const LONGEST_M: f64 = 4000.0;
@@ -101,6 +103,10 @@ fn octave_scale(lambda: f64) -> f64 {
 static OCTAVE_SCALES: std::sync::LazyLock<[f64; MAX_OCTAVES as usize]> =
     std::sync::LazyLock::new(|| std::array::from_fn(|k| octave_scale(wavelength(k as u32))));
 
+/// (sin, cos) of each octave's lattice turn, computed once.
+static LATTICE_TURNS: std::sync::LazyLock<[(f64, f64); MAX_OCTAVES as usize]> =
+    std::sync::LazyLock::new(|| std::array::from_fn(|k| (k as f64 * GOLDEN_ANGLE + LATTICE_ANGLE).sin_cos()));
+
 /// The erosion filter of one world seed.
 #[derive(Clone, Copy, Debug)]
 pub struct ErosionFilter {
@@ -138,13 +144,14 @@ impl ErosionFilter {
             if amp < MIN_AMPLITUDE_M {
                 break;
             }
-            let norm = gx.hypot(gz);
+            // Not `hypot`: a libm call, and gradients are far from overflowing.
+            let norm = (gx * gx + gz * gz).sqrt();
             // Downhill; on dead-flat ground any fixed direction will do.
             let dir = if norm > 1e-12 { (-gx / norm, -gz / norm) } else { (1.0, 0.0) };
             // Each octave's lattice is turned by its own angle: the noise's cells are squares,
             // and on one common axis-aligned lattice their edges line up into straight
             // north-south and east-west lines across the hillshade.
-            let (sin, cos) = (f64::from(k) * GOLDEN_ANGLE + LATTICE_ANGLE).sin_cos();
+            let (sin, cos) = LATTICE_TURNS[k as usize];
             let turn = |(a, b): (f64, f64)| (cos * a - sin * b, sin * a + cos * b);
             let (px, pz) = turn((x / lambda, z / lambda));
             let g = gullies(splitmix(self.seed ^ u64::from(k)), px, pz, turn(dir));
@@ -177,7 +184,7 @@ const REACH: f64 = 1.5;
 /// the cell lines, left steps of metres along a straight lattice there, visible in hillshades.)
 /// In [−1, 1].
 fn gullies(seed: u64, px: f64, pz: f64, dir: (f64, f64)) -> Gully {
-    let (ix, iz) = (px.floor(), pz.floor());
+    let (ix, iz) = (floor(px), floor(pz));
     let (fx, fz) = (px - ix, pz - iz);
     let (cx, cz) = (ix as i64, iz as i64);
     // Across the flow: the stripe's phase changes only in this direction.
@@ -197,7 +204,7 @@ fn gullies(seed: u64, px: f64, pz: f64, dir: (f64, f64)) -> Gully {
                 continue; // weight 0: skip the trigonometry (a third of the points)
             }
             let w = (1.0 - r2 / (REACH * REACH)).powi(4);
-            let (s, c) = (TAU * (ox * across.0 + oz * across.1)).sin_cos();
+            let (s, c) = sin_cos_turns(ox * across.0 + oz * across.1);
             value += c * w;
             dx -= s * TAU * across.0 * w;
             dz -= s * TAU * across.1 * w;

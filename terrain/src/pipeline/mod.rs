@@ -8,6 +8,7 @@
 //! Must not touch: Minecraft (block ids, biomes, chunks) — callers map metres and climate to
 //! blocks themselves.
 
+mod column_cache;
 mod finest;
 mod network_inputs;
 
@@ -29,6 +30,7 @@ use crate::resample;
 pub use crate::settings::BLOCKS_PER_MODEL_PIXEL;
 use crate::settings::{StageName, TerrainSettings};
 use crate::tile::{Rect, Tile};
+use column_cache::ColumnCache;
 use finest::Finest;
 use network_inputs::NetworkInputs;
 
@@ -158,6 +160,8 @@ pub struct Pipeline {
     continental: Arc<dyn Source>,
     network: Arc<dyn Source>,
     rivers: Rivers,
+    /// Block columns already computed, in chunk-sized squares.
+    column_cache: ColumnCache,
 }
 
 impl Pipeline {
@@ -257,6 +261,7 @@ impl Pipeline {
             continental,
             network,
             rivers,
+            column_cache: ColumnCache::default(),
         })
     }
 
@@ -390,8 +395,14 @@ impl Pipeline {
     /// All channels for every block column of `blocks` (y = z, x = x in block coordinates):
     /// the model grid upsampled 4× (elevation by a cubic, climate bilinearly), with the
     /// erosion filter's octaves below the model grid carved into the elevation and the
-    /// temperature following it down the lapse rate.
+    /// temperature following it down the lapse rate. Small queries are answered from (and
+    /// remembered in) a cache of chunk-sized squares: neighbouring chunks share their borders.
     pub fn columns(&self, blocks: Rect) -> Tile {
+        self.column_cache.columns(blocks, |rect| self.compute_columns(rect))
+    }
+
+    /// [`Pipeline::columns`], computed.
+    fn compute_columns(&self, blocks: Rect) -> Tile {
         let (model, slope) = self.model_and_slope(Pipeline::model_rect(&blocks));
         let finest = Tile::stack(&[&model.select(&[channel::ELEVATION]), &slope]);
         let (mut elevation, smooth) = self.carve_blocks(&finest, blocks);
