@@ -23,7 +23,7 @@ use crate::encoding::box_downsample;
 use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
 use crate::hydrology::continental::Continental;
 use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns, CELL_METRES, RIVER_DISTANCE_MAX_M};
-use crate::infinite::{Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
+use crate::infinite::{tiled, Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
 use crate::layout::{sketch, Layout};
 use crate::model_files::ModelFiles;
 use crate::resample;
@@ -39,6 +39,8 @@ use network_inputs::NetworkInputs;
 pub const BASE_METRES: f64 = 500.0;
 /// The coarse grid, metres: continents, shelves, climate.
 pub const COARSE_METRES: f64 = 8000.0;
+/// Side of the cached tiles of the layout's coarse fields, cells (512 km).
+const COARSE_TILE: i64 = 64;
 /// Ratio of the 4× block upsampling (block size / model pixel size).
 const BLOCK_RATIO: f64 = 1.0 / BLOCKS_PER_MODEL_PIXEL as f64;
 
@@ -191,7 +193,11 @@ impl Pipeline {
         let layout = Layout::new(seed, &settings.layout);
         let coarse_metres = COARSE_METRES;
         let mut stages = stages::current();
-        let sketch = StageGrid::layout(Arc::new(layout.elevation(coarse_metres)), coarse_metres);
+        // The layout's coarse fields are read over continents (drainage, rain): cached.
+        let sketch = StageGrid::layout(
+            tiled(&engine, Arc::new(layout.elevation(coarse_metres)), COARSE_TILE, "coarse layout"),
+            coarse_metres,
+        );
         // The learned stages, coarse to fine, each refining the output of its context stage
         // (the layout's sketch when that stage is off).
         let mut ran: Vec<StageGrid> = Vec::new();
@@ -203,7 +209,8 @@ impl Pipeline {
         // The coarse grid (climate, spawn search) carries the finest stage that lives on it.
         let coarse_elevation =
             ran.iter().rev().find(|g| g.metres == coarse_metres).map_or(sketch.source.clone(), |g| g.source.clone());
-        let coarse_sketch: Arc<dyn Source> = Arc::new(layout.climate_sketch(coarse_metres));
+        let coarse_sketch: Arc<dyn Source> =
+            tiled(&engine, Arc::new(layout.climate_sketch(coarse_metres)), COARSE_TILE, "climate sketch");
         let orographic = || Orographic {
             elevation: coarse_elevation.clone(),
             sketch: coarse_sketch.clone(),
