@@ -608,3 +608,34 @@ fn a_players_edits_are_seen_by_others_and_kept_after_a_reconnect_and_a_restart()
     check(&server.probe("after_restart", &["--columns".into(), list]), "after a restart");
     assert!(server.stop().success());
 }
+
+#[test]
+fn a_survival_player_digs_by_hand_and_picks_up_what_the_block_drops() {
+    let seed = 6;
+    let config = fixtures::seeded_config(seed);
+    let rules = fixtures::shipped_rules();
+    let generator = generator(&config);
+    let spawn = find_spawn(&generator, &rules);
+    let ground = generator.surface(&rules, i64::from(spawn.block.x), i64::from(spawn.block.z));
+    let mut server = Server::start_with_server_keys(&fixtures::shipped_biomes(), seed, "gamemode = \"survival\"", "");
+    let report = server.node("drop.js", &[]);
+    assert_eq!(report["ok"], true, "{report}");
+    assert_eq!(report["game_mode"], "survival", "{report}");
+    // The block under the spawn, dug by hand: grassy soil gives dirt; sand and mud themselves.
+    let dug = report["dug"]["name"].as_str().expect("dug block");
+    assert_eq!(dug, ground.top, "{report}");
+    let expected = match dug {
+        "grass_block" | "podzol" | "mycelium" | "dirt" => "dirt",
+        "sand" | "red_sand" | "mud" | "coarse_dirt" => dug,
+        other => panic!("seed {seed} spawns on {other}: pick a seed that spawns on soil or sand"),
+    };
+    assert_eq!(report["before"], serde_json::json!([]), "{report}");
+    assert_eq!(report["after"], serde_json::json!([{ "name": expected, "count": 1 }]), "{report}");
+    // The drop lay where the block was.
+    let (x, y, z) = (&report["dug"]["x"], &report["dug"]["y"], &report["dug"]["z"]);
+    let at = &report["drop_at"];
+    assert_eq!(at["x"].as_f64().map(f64::floor), x.as_f64(), "{report}");
+    assert_eq!(at["z"].as_f64().map(f64::floor), z.as_f64(), "{report}");
+    assert_eq!(at["y"].as_f64().map(f64::floor), y.as_f64(), "{report}");
+    assert!(server.stop().success());
+}

@@ -20,6 +20,7 @@ use valence::prelude::*;
 use valence::protocol::{CompressionThreshold, PacketEncoder};
 
 use super::dimension::{Palette, WorldSetup};
+use super::drops;
 use super::stream::Streamer;
 use crate::chunkgen::{Light, States};
 use crate::world::codec::Encoder;
@@ -42,6 +43,7 @@ pub fn build(app: &mut App) {
     app.init_resource::<Edited>()
         .add_systems(PostStartup, make_saver)
         .add_systems(Update, (dig, place, save_edited).chain());
+    drops::build(app);
 }
 
 fn make_saver(mut commands: Commands, setup: Res<WorldSetup>, palette: Res<Palette>, server: Res<Server>) {
@@ -54,25 +56,31 @@ fn make_saver(mut commands: Commands, setup: Res<WorldSetup>, palette: Res<Palet
 }
 
 fn dig(
-    clients: Query<&GameMode>,
-    mut layers: Query<&mut ChunkLayer>,
+    mut commands: Commands,
+    clients: Query<(&GameMode, &Inventory, &HeldItem)>,
+    mut layers: Query<(Entity, &mut ChunkLayer)>,
     mut events: EventReader<DiggingEvent>,
     mut edited: ResMut<Edited>,
 ) {
-    let Ok(mut layer) = layers.get_single_mut() else { return };
+    let Ok((layer_entity, mut layer)) = layers.get_single_mut() else { return };
     for event in events.iter() {
-        let Ok(mode) = clients.get(event.client) else { continue };
+        let Ok((mode, inventory, held)) = clients.get(event.client) else { continue };
         let done = match *mode {
             GameMode::Creative => event.state == DiggingState::Start,
             GameMode::Survival => event.state == DiggingState::Stop,
             GameMode::Adventure | GameMode::Spectator => false,
         };
-        let Some(block) = layer.block(event.position) else { continue };
-        if !done || block.state.is_air() || block.state == BlockState::BEDROCK && *mode != GameMode::Creative {
+        let Some(state) = layer.block(event.position).map(|b| b.state) else { continue };
+        if !done || state.is_air() || state == BlockState::BEDROCK && *mode != GameMode::Creative {
             continue;
         }
         layer.set_block(event.position, BlockState::AIR);
         edited.0.insert(ChunkPos::from_block_pos(event.position));
+        if *mode == GameMode::Survival {
+            if let Some(drop) = drops::drop_of(state, drops::held(inventory, held), event.position) {
+                drops::spawn(&mut commands, layer_entity, event.position, drop);
+            }
+        }
     }
 }
 

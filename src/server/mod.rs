@@ -17,6 +17,7 @@ macro_rules! say {
 
 mod console;
 mod dimension;
+mod drops;
 mod edit;
 mod lifecycle;
 mod players;

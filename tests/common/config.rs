@@ -21,9 +21,14 @@ pub fn seed_only(seed: u64) -> String {
 /// a small chunk cache, world `seed`, and `world` appended to the `[world]` table (it may open
 /// further tables after its own keys).
 pub fn server(port: u16, seed: u64, world: &str) -> String {
+    server_with(port, seed, "", world)
+}
+
+/// [`server`] with `server_keys` (lines) added to its `[server]` table.
+pub fn server_with(port: u16, seed: u64, server_keys: &str, world: &str) -> String {
     format!(
-        "[server]\nbind = \"127.0.0.1:{port}\"\nview_distance_cap = {VIEW}\nchunk_threads = 2\nchunk_cache = 512\n\n\
-         [world]\nseed = {seed}\n{world}"
+        "[server]\nbind = \"127.0.0.1:{port}\"\nview_distance_cap = {VIEW}\nchunk_threads = 2\nchunk_cache = 512\n\
+         {server_keys}\n[world]\nseed = {seed}\n{world}"
     )
 }
 

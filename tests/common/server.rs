@@ -41,9 +41,18 @@ impl Server {
         Server::start_in(biomes, seed, tempfile::tempdir().expect("temp dir"), world)
     }
 
+    /// [`Server::start_with`], with `server_keys` (lines) added to the `[server]` table.
+    pub fn start_with_server_keys(biomes: &Path, seed: u64, server_keys: &str, world: &str) -> Server {
+        Server::start_configured(biomes, seed, tempfile::tempdir().expect("temp dir"), server_keys, world)
+    }
+
     fn start_in(biomes: &Path, seed: u64, dir: tempfile::TempDir, world: &str) -> Server {
+        Server::start_configured(biomes, seed, dir, "", world)
+    }
+
+    fn start_configured(biomes: &Path, seed: u64, dir: tempfile::TempDir, server_keys: &str, world: &str) -> Server {
         let port = free_port();
-        let config_path = config::write(dir.path(), &config::server(port, seed, world));
+        let config_path = config::write(dir.path(), &config::server_with(port, seed, server_keys, world));
         let config = Config::load(&config_path).expect("test config loads");
         let args =
             ["serve".as_ref(), "--config".as_ref(), config_path.as_os_str(), "--biomes".as_ref(), biomes.as_os_str()];

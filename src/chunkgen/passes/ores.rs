@@ -79,19 +79,80 @@ pub const ORES: [Ore; 22] = {
     ]
 };
 
-/// Squared radius (blocks²) of the ball a vein of `size` blocks fills: (4/3)·π·R³ = size.
-fn radius2(size: u32) -> f32 {
-    (3.0 * size as f32 / (4.0 * std::f32::consts::PI)).powf(2.0 / 3.0)
-}
-
-/// How far (blocks) a vein of `size` blocks reaches from its start, jitter included.
-fn reach(size: u32) -> i64 {
-    (radius2(size) + JITTER).sqrt().ceil() as i64
-}
+/// Blocks a vanilla vein of each `size` places in solid stone, on average: a Monte Carlo of
+/// vanilla's `OreFeature` (`scripts/vanilla-ore-veins`, 20,000 veins a size). A vein's
+/// `size` is not its block count: small ones place fewer (size 3, an emerald vein, 0.47), the
+/// long blobs far more (size 64, granite, 685).
+const VANILLA_BLOCKS: [(u32, f32); 10] = [
+    (3, 0.47),
+    (4, 1.98),
+    (7, 4.95),
+    (8, 5.77),
+    (9, 6.81),
+    (10, 8.42),
+    (12, 11.64),
+    (17, 22.10),
+    (33, 111.84),
+    (64, 684.63),
+];
 
 /// Up to this much (blocks²) is added to a block's squared distance from a vein's start, so
 /// veins are lumpy rather than balls.
 const JITTER: f32 = 1.5;
+
+/// How many blocks a ball of squared radius `r2` places on average: each block within the
+/// jittered reach counts with the chance its jitter lets it in.
+fn expected_blocks(r2: f32) -> f32 {
+    let r = (r2 + JITTER).sqrt().ceil() as i32;
+    let mut n = 0.0;
+    for dy in -r..=r {
+        for dz in -r..=r {
+            for dx in -r..=r {
+                let d2 = (dx * dx + dy * dy + dz * dz) as f32;
+                n += ((r2 + JITTER * 0.5 - d2) / JITTER).clamp(0.0, 1.0);
+            }
+        }
+    }
+    n
+}
+
+/// Squared radius (blocks²) of the ball a vein of vanilla `size` fills: the one that places
+/// vanilla's mean number of blocks ([`VANILLA_BLOCKS`]), by bisection, computed once.
+fn radius2(size: u32) -> f32 {
+    static RADII: std::sync::LazyLock<Vec<(u32, f32)>> = std::sync::LazyLock::new(|| {
+        VANILLA_BLOCKS
+            .iter()
+            .map(|&(size, want)| {
+                let (mut lo, mut hi) = (-JITTER, 400.0f32);
+                for _ in 0..40 {
+                    let mid = 0.5 * (lo + hi);
+                    if expected_blocks(mid) < want {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                (size, 0.5 * (lo + hi))
+            })
+            .collect()
+    });
+    RADII.iter().find(|&&(s, _)| s == size).map_or_else(|| panic!("no vanilla vein of size {size}"), |&(_, r2)| r2)
+}
+
+/// Whether the block at offset `d` from a vein's start is in the vein of squared radius `r2`
+/// and lumps `salt`.
+fn in_vein(salt: u64, r2: f32, (dx, dy, dz): (i64, i64, i64)) -> bool {
+    // One multiply per block (not a full hash): plenty for lumpiness.
+    let cell = ((dx + 16) | (dy + 16) << 5 | (dz + 16) << 10) as u64;
+    let h = (salt ^ cell).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let jitter = (h >> 40) as f32 / (1u64 << 24) as f32 * JITTER;
+    (dx * dx + dy * dy + dz * dz) as f32 + jitter <= r2 + JITTER * 0.5
+}
+
+/// How far (blocks) a vein of `size` reaches from its start, jitter included.
+fn reach(size: u32) -> i64 {
+    (radius2(size) + JITTER).max(0.0).sqrt().ceil() as i64
+}
 
 /// Writes every vein that starts in this chunk or a neighbour into this chunk.
 pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
@@ -153,8 +214,9 @@ pub fn starts(seed: u64, kind: u64, (cx, cz): (i64, i64), ore: &Ore) -> Vec<(i64
         .collect()
 }
 
-/// One vein of about `ore.size` blocks: the blocks within the vein's ball of its start, each
-/// block's distance jittered so veins are lumpy, written where they fall inside the chunk.
+/// One vein of vanilla's `ore.size`, as many blocks as vanilla's place on average: the blocks
+/// within the vein's ball around its start, each block's distance jittered so veins are
+/// lumpy, written where they fall inside the chunk.
 fn place_vein(
     chunk: &mut UnloadedChunk,
     x0: i64,
@@ -180,11 +242,7 @@ fn place_vein(
                 if !(0..CHUNK).contains(&lx) {
                     continue;
                 }
-                // One multiply per block (not a full hash): plenty for lumpiness.
-                let cell = ((dx + 16) | (dy + 16) << 5 | (dz + 16) << 10) as u64;
-                let h = (salt ^ cell).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-                let jitter = (h >> 40) as f32 / (1u64 << 24) as f32 * JITTER;
-                if (dx * dx + dy * dy + dz * dz) as f32 + jitter > r2 + JITTER * 0.5 {
+                if !in_vein(salt, r2, (dx, dy, dz)) {
                     continue;
                 }
                 let (lx, ly, lz) = (lx as u32, ly as u32, lz as u32);
@@ -217,6 +275,25 @@ mod tests {
         super::super::rock::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);
         chunk
+    }
+
+    #[test]
+    fn veins_place_as_many_blocks_as_vanillas_on_average() {
+        for &(size, want) in &VANILLA_BLOCKS {
+            let r = reach(size);
+            let r2 = radius2(size);
+            let (mut total, veins) = (0usize, 2000u64);
+            for salt in 0..veins {
+                let salt = hash3(11, 0x0E1A, salt as i64, 0, 0);
+                for dy in -r..=r {
+                    for dz in -r..=r {
+                        total += (-r..=r).filter(|&dx| in_vein(salt, r2, (dx, dy, dz))).count();
+                    }
+                }
+            }
+            let mean = total as f32 / veins as f32;
+            assert!((mean - want).abs() <= 0.08 * want + 0.05, "size {size}: {mean} blocks a vein, vanilla {want}");
+        }
     }
 
     #[test]
