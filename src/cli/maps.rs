@@ -10,7 +10,7 @@ use crate::chunkgen::Generator;
 use crate::config::Config;
 use crate::export::{self, ExportRequest, Grid, Quantity, Vertical};
 use crate::lab::relief_compare::{self, CompareRequest};
-use crate::render::{self, Layer, ObliqueRequest, RenderRequest};
+use crate::render::{self, CutawayRequest, Layer, ObliqueRequest, RenderRequest};
 use crate::terrain::model_files::ModelFiles;
 use crate::terrain::Pipeline;
 
@@ -75,6 +75,9 @@ pub enum View {
     Map,
     /// From above at an angle, block columns as voxels.
     Oblique,
+    /// A vertical slice along the rectangle's north edge (z = z0, the size's width), every
+    /// block from the bedrock to the sky: caves, ores, rock and the deepslate transition.
+    Cutaway,
 }
 
 /// Arguments of `infiniterra export`.
@@ -163,6 +166,22 @@ pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), 
         let req = CompareRequest { x0, z0, width, height };
         let mut progress = Progress::new("render", "rows of windows");
         let image = relief_compare::render_relief_comparison(&pipeline(config, &models)?, real, &req, &mut |d, t| {
+            progress.update(d, t)
+        })
+        .map_err(|e| classify(e.is_bad_input(), e))?;
+        progress.finish();
+        return save(&image, &a.out);
+    }
+    if a.view == View::Cutaway {
+        if a.zoom != 1 || a.layer != Layer::Elevation {
+            return Err(Failure::input(anyhow::anyhow!(
+                "--view cutaway draws every block of one row at 3 pixels a block: --zoom and --layer do not apply"
+            )));
+        }
+        let rules = rules.load().map_err(Failure::input)?;
+        let generator = Generator::new(std::sync::Arc::new(pipeline(config, &models)?), config);
+        let mut progress = Progress::new("render", "chunks");
+        let image = render::render_cutaway(&generator, &rules, &CutawayRequest { x0, z: z0, width }, &mut |d, t| {
             progress.update(d, t)
         })
         .map_err(|e| classify(e.is_bad_input(), e))?;

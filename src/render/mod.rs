@@ -6,6 +6,7 @@
 //! command line (the CLI parses flags into a [`RenderRequest`] and reports errors).
 
 mod biomes;
+mod cutaway;
 mod layer;
 mod oblique;
 pub(crate) mod panel;
@@ -19,6 +20,7 @@ use std::path::{Path, PathBuf};
 use image::{Rgb, RgbImage};
 
 pub use biomes::render_biomes;
+pub use cutaway::{render_cutaway, CutawayRequest, MAX_CUTAWAY_WIDTH};
 pub use layer::{Layer, UnknownLayer};
 pub use oblique::{render_oblique, ObliqueRequest, MAX_OBLIQUE_SIDE};
 pub use water::render_water;
