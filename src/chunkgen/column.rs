@@ -101,6 +101,14 @@ impl Generator {
             let rooted = !cave_field::may_open(self.seed, columns, x, z);
             if dry && rooted && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top)
             {
+                // A 2×2 trunk needs its other three columns level, dry and whole.
+                let even = Tree::extra_trunk_columns(kind).iter().all(|&(dx, dz)| {
+                    let (x, z) = (x + dx, z + dz);
+                    columns.surface_y(x, z) == ground_y
+                        && !columns.is_wet(x, z)
+                        && !cave_field::may_open(self.seed, columns, x, z)
+                });
+                let kind = if even { kind } else { Tree::small_dark_oak() };
                 let tree = Tree::new(self.seed, x, z, ground_y, kind);
                 if tree.top_y() < v.min_y + v.height {
                     trees.push(tree);
@@ -221,8 +229,9 @@ mod tests {
     }
 
     #[test]
-    fn a_chunk_needs_four_columns_of_border_and_any_square_its_cells() {
-        assert_eq!(tree_rect(0, 16, 16), Rect::new(12, -4, 24, 24));
+    fn a_chunk_needs_its_tree_reach_and_one_column_of_border_and_any_square_its_cells() {
+        let border = trees::REACH + 1;
+        assert_eq!(tree_rect(0, 16, 16), Rect::new(16 - border, -border, 16 + 2 * border, 16 + 2 * border));
         for x in -9..9 {
             let r = tree_rect(x, x, 1);
             // The cell of the farthest root on each side, with its sample column's neighbours.

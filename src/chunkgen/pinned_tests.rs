@@ -118,10 +118,11 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
 /// world with the shipped biome rules) outside the shallow sea, re-recorded when ore veins
-/// took vanilla's mean block counts (granite blobs of ~685 blocks, diamond veins of ~2).
-const OUTSIDE_SHALLOWS_HASH: u64 = 0x43fe_1c57_018e_3b80;
+/// took vanilla's mean block counts (granite blobs of ~685 blocks, diamond veins of ~2), and
+/// again for acacias that bend and 2×2 dark oaks (trees reach 4 blocks from their trunk).
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xd31a_73f7_fd4d_e58c;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded as above.
-const PROCEDURAL_HASH: u64 = 0xa5df_c144_9eca_fc29;
+const PROCEDURAL_HASH: u64 = 0x5293_136a_093f_83c5;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]

@@ -12,7 +12,7 @@ use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
 use super::hash::{hash3, unit3};
 
 /// How far a tree reaches from its trunk, blocks (the widest crown's radius plus a margin).
-pub const REACH: i64 = 3;
+pub const REACH: i64 = 4;
 /// Edge of a tree cell, blocks: neighbouring trunks are at least 3 blocks apart.
 const CELL: i64 = 5;
 const SALT_SPOT: u64 = 0x7472_6565;
@@ -26,6 +26,10 @@ pub enum Kind {
     Round { log: BlockState, leaves: BlockState, min_height: i32 },
     /// A narrow cone of spruce.
     Spruce,
+    /// Acacia: a trunk whose top bends off diagonally, under a flat canopy.
+    Acacia,
+    /// Dark oak: a 2×2 trunk under a broad, low crown.
+    DarkOak,
 }
 
 /// One tree.
@@ -41,6 +45,8 @@ pub struct Tree {
     pub kind: Kind,
     /// Trunk height, blocks.
     pub height: i32,
+    /// Which way an acacia's top bends (a diagonal, each part −1 or 1).
+    pub lean: (i64, i64),
 }
 
 /// The tree cells whose possible root lies within `REACH` of the chunk at block `(x0, z0)`:
@@ -71,15 +77,13 @@ pub fn woodland(biome: &str) -> Option<(f32, Kind)> {
     Some(match b {
         "forest" | "flower_forest" => (0.7, oak),
         "birch_forest" | "old_growth_birch_forest" => (0.75, birch),
-        "dark_forest" => (0.95, round(BlockState::DARK_OAK_LOG, BlockState::DARK_OAK_LEAVES, 4)),
+        "dark_forest" => (0.8, Kind::DarkOak),
         "taiga" | "snowy_taiga" | "old_growth_pine_taiga" | "old_growth_spruce_taiga" => (0.7, Kind::Spruce),
         "grove" => (0.45, Kind::Spruce),
         "windswept_forest" => (0.4, Kind::Spruce),
         "jungle" => (0.9, round(BlockState::JUNGLE_LOG, BlockState::JUNGLE_LEAVES, 6)),
         "sparse_jungle" | "bamboo_jungle" => (0.3, round(BlockState::JUNGLE_LOG, BlockState::JUNGLE_LEAVES, 5)),
-        "savanna" | "savanna_plateau" | "windswept_savanna" => {
-            (0.12, round(BlockState::ACACIA_LOG, BlockState::ACACIA_LEAVES, 4))
-        }
+        "savanna" | "savanna_plateau" | "windswept_savanna" => (0.12, Kind::Acacia),
         "swamp" => (0.3, oak),
         "mangrove_swamp" => (0.45, round(BlockState::MANGROVE_LOG, BlockState::MANGROVE_LEAVES, 5)),
         "cherry_grove" => (0.5, round(BlockState::CHERRY_LOG, BlockState::CHERRY_LEAVES, 4)),
@@ -100,12 +104,43 @@ pub fn holds_tree(top: BlockState) -> bool {
 impl Tree {
     /// A tree of `kind` at a root, its height drawn from the root's hash.
     pub fn new(seed: u64, x: i64, z: i64, ground_y: i32, kind: Kind) -> Tree {
-        let draw = (hash3(seed, SALT_SHAPE, x, 0, z) % 3) as i32;
+        let h = hash3(seed, SALT_SHAPE, x, 0, z);
+        let draw = (h % 3) as i32;
         let height = match kind {
             Kind::Round { min_height, .. } => min_height + draw,
             Kind::Spruce => 6 + draw * 2,
+            Kind::Acacia => 5 + draw,
+            Kind::DarkOak => 6 + draw,
         };
-        Tree { x, z, ground_y, kind, height }
+        let lean = (if h >> 8 & 1 == 0 { -1 } else { 1 }, if h >> 9 & 1 == 0 { -1 } else { 1 });
+        Tree { x, z, ground_y, kind, height, lean }
+    }
+
+    /// The round dark oak that stands where a 2×2 one cannot (uneven or wet ground).
+    pub fn small_dark_oak() -> Kind {
+        Kind::Round { log: BlockState::DARK_OAK_LOG, leaves: BlockState::DARK_OAK_LEAVES, min_height: 4 }
+    }
+
+    /// Columns besides the root the trunk stands on (offsets).
+    pub fn extra_trunk_columns(kind: Kind) -> &'static [(i64, i64)] {
+        match kind {
+            Kind::DarkOak => &[(1, 0), (0, 1), (1, 1)],
+            _ => &[],
+        }
+    }
+
+    /// Every log position, relative to the root column and the ground (dx, dy ≥ 1, dz).
+    fn logs(&self) -> Vec<(i64, i32, i64)> {
+        let h = self.height;
+        match self.kind {
+            Kind::Round { .. } | Kind::Spruce => (1..=h).map(|y| (0, y, 0)).collect(),
+            // Straight, then the top two logs a diagonal step aside.
+            Kind::Acacia => {
+                let (lx, lz) = self.lean;
+                (1..=h).map(|y| if y < h - 1 { (0, y, 0) } else { (lx, y, lz) }).collect()
+            }
+            Kind::DarkOak => (1..=h).flat_map(|y| [(0, y, 0), (1, y, 0), (0, y, 1), (1, y, 1)]).collect(),
+        }
     }
 
     /// Highest block Y the tree occupies.
@@ -113,35 +148,51 @@ impl Tree {
         self.ground_y + self.height + 1
     }
 
-    /// Every leaf position, relative to the trunk's top block (dx, dy, dz).
+    /// Every leaf position, relative to the root column and the ground (dx, dy, dz). Logs
+    /// are placed first and leaves only into air, so leaves listed over a log are harmless.
     fn crown(&self) -> Vec<(i64, i32, i64)> {
+        let top = self.height;
         let mut leaves = Vec::new();
-        let mut layer = |dy: i32, r: i64, corners: bool| {
-            for dz in -r..=r {
-                for dx in -r..=r {
-                    let trunk = (dx, dz) == (0, 0) && dy <= 0;
-                    let corner = r > 0 && dx.abs() == r && dz.abs() == r;
-                    if !trunk && (corners || !corner) {
-                        leaves.push((dx, dy, dz));
+        // A square ring of radius `r` around (cx, cz) at `dy` above the trunk's top; `wide`
+        // squares span the 2×2 trunk (cx..=cx+1).
+        let mut square = |(cx, cz): (i64, i64), dy: i32, r: i64, corners: bool, wide: bool| {
+            let hi = if wide { r + 1 } else { r };
+            let lo = if wide && r == 0 { 0 } else { -r };
+            for dz in lo..=hi {
+                for dx in lo..=hi {
+                    let corner = r > 0 && (dx == lo || dx == hi) && (dz == lo || dz == hi);
+                    if corners || !corner {
+                        leaves.push((cx + dx, top + dy, cz + dz));
                     }
                 }
             }
         };
         match self.kind {
             Kind::Round { .. } => {
-                layer(-2, 2, false);
-                layer(-1, 2, false);
-                layer(0, 1, true);
-                layer(1, 1, false);
+                square((0, 0), -2, 2, false, false);
+                square((0, 0), -1, 2, false, false);
+                square((0, 0), 0, 1, true, false);
+                square((0, 0), 1, 1, false, false);
             }
             Kind::Spruce => {
-                layer(1, 0, true);
-                layer(0, 1, false);
+                square((0, 0), 1, 0, true, false);
+                square((0, 0), 0, 1, false, false);
                 // Alternating rings down the trunk, wider lower down.
                 for dy in (3 - self.height..0).rev() {
                     let r = if (dy - self.height).rem_euclid(2) == 0 { 1 } else { 2 };
-                    layer(dy, r, r == 1);
+                    square((0, 0), dy, r, r == 1, false);
                 }
+            }
+            // Flat: a broad layer at the bent top and a small one over it.
+            Kind::Acacia => {
+                square(self.lean, 0, 2, false, false);
+                square(self.lean, 1, 1, false, false);
+            }
+            // Low and broad over the 2×2 trunk: 6×6, 4×4 and 2×2 layers.
+            Kind::DarkOak => {
+                square((0, 0), -1, 2, false, true);
+                square((0, 0), 0, 1, true, true);
+                square((0, 0), 1, 0, true, true);
             }
         }
         leaves
@@ -151,6 +202,8 @@ impl Tree {
         match self.kind {
             Kind::Round { log, leaves, .. } => (log, leaves),
             Kind::Spruce => (BlockState::SPRUCE_LOG, BlockState::SPRUCE_LEAVES),
+            Kind::Acacia => (BlockState::ACACIA_LOG, BlockState::ACACIA_LEAVES),
+            Kind::DarkOak => (BlockState::DARK_OAK_LOG, BlockState::DARK_OAK_LEAVES),
         }
     }
 }
@@ -170,17 +223,16 @@ pub fn place(chunk: &mut UnloadedChunk, trees: &[Tree], x0: i64, z0: i64, min_y:
     };
     for t in trees {
         let (log, _) = t.blocks();
-        for y in t.ground_y + 1..=t.ground_y + t.height {
-            put(t.x, y, t.z, log, false);
+        for (dx, dy, dz) in t.logs() {
+            put(t.x + dx, t.ground_y + dy, t.z + dz, log, false);
         }
     }
     for t in trees {
         let (_, leaves) = t.blocks();
         // Generated leaves must not decay if a client ever ticks them.
         let leaves = leaves.set(PropName::Persistent, PropValue::True);
-        let top = t.ground_y + t.height;
         for (dx, dy, dz) in t.crown() {
-            put(t.x + dx, top + dy, t.z + dz, leaves, true);
+            put(t.x + dx, t.ground_y + dy, t.z + dz, leaves, true);
         }
     }
 }
@@ -210,14 +262,25 @@ mod tests {
 
     #[test]
     fn crowns_stay_within_reach_and_trunks_stay_clear() {
-        for kind in [Kind::Spruce, woodland("minecraft:forest").map(|w| w.1).unwrap_or(Kind::Spruce)] {
+        let forest = woodland("minecraft:forest").map_or(Kind::Spruce, |w| w.1);
+        for kind in [Kind::Spruce, forest, Kind::Acacia, Kind::DarkOak, Tree::small_dark_oak()] {
             for draw in 0..20 {
                 let t = Tree::new(draw, 0, 0, 70, kind);
-                let crown = t.crown();
-                assert!(crown.iter().all(|&(dx, _, dz)| dx.abs() < REACH && dz.abs() < REACH));
-                assert!(!crown.iter().any(|&(dx, dy, dz)| dx == 0 && dz == 0 && dy <= 0), "leaves inside the trunk");
+                let (crown, logs) = (t.crown(), t.logs());
+                assert!(crown.iter().chain(&logs).all(|&(dx, _, dz)| dx.abs() < REACH && dz.abs() < REACH), "{kind:?}");
+                assert_eq!(logs.len() as i32, t.height * (1 + Tree::extra_trunk_columns(kind).len() as i32));
+                assert!(logs.iter().all(|&(_, dy, _)| (1..=t.height).contains(&dy)));
+                // Every leaf hangs over the ground the trunk stands on, and the crown tops it.
+                assert!(crown.iter().all(|&(_, dy, _)| dy > 1 && dy <= t.height + 1), "{kind:?}");
+                assert_eq!(crown.iter().map(|l| l.1).max(), Some(t.top_y() - t.ground_y), "{kind:?}");
             }
         }
+        // An acacia's top bends a diagonal step off its trunk; a dark oak stands on 2×2.
+        let acacia = Tree::new(1, 0, 0, 70, Kind::Acacia);
+        let top = acacia.logs().into_iter().max_by_key(|l| l.1).expect("logs");
+        assert_eq!((top.0.abs(), top.2.abs()), (1, 1));
+        let oak = Tree::new(1, 0, 0, 70, Kind::DarkOak);
+        assert!(oak.logs().contains(&(1, 1, 1)) && oak.logs().contains(&(0, 1, 0)));
     }
 
     #[test]
@@ -240,5 +303,81 @@ mod tests {
         assert_eq!(at(16, top, 8).to_kind(), BlockState::SPRUCE_LEAVES.to_kind(), "crown crosses the border");
         assert_eq!(at(14, top, 8).to_kind(), BlockState::SPRUCE_LEAVES.to_kind());
         assert!((0..128).all(|y| right.block_state(0, y, 0).is_air()));
+    }
+}
+
+/// The species side by side, seen from the south (`docs/trees.png`): run with
+/// `cargo test -p infiniterra --lib -- --ignored draw_the_species`.
+#[cfg(test)]
+mod picture {
+    use super::*;
+    use image::{Rgb, RgbImage};
+
+    const PX: u32 = 8;
+
+    fn colour(b: BlockState) -> Option<Rgb<u8>> {
+        let name = b.to_kind().to_str();
+        let c = match name {
+            _ if name.ends_with("_log") => match name {
+                "birch_log" => [220, 217, 200],
+                "dark_oak_log" => [60, 46, 26],
+                "acacia_log" => [103, 96, 86],
+                "cherry_log" => [54, 33, 44],
+                "jungle_log" => [85, 67, 25],
+                "spruce_log" => [58, 37, 16],
+                "mangrove_log" => [84, 66, 40],
+                _ => [109, 85, 50],
+            },
+            "cherry_leaves" => [232, 170, 200],
+            "birch_leaves" => [128, 167, 85],
+            "spruce_leaves" => [97, 153, 97],
+            "acacia_leaves" => [110, 140, 40],
+            "dark_oak_leaves" => [50, 110, 30],
+            "jungle_leaves" => [48, 170, 30],
+            "mangrove_leaves" => [100, 160, 50],
+            _ if name.ends_with("_leaves") => [72, 140, 40],
+            _ => return None,
+        };
+        Some(Rgb(c))
+    }
+
+    #[test]
+    #[ignore = "writes docs/trees.png"]
+    fn draw_the_species_side_by_side() {
+        let kinds: Vec<Kind> =
+            ["forest", "birch_forest", "taiga", "savanna", "dark_forest", "jungle", "cherry_grove", "mangrove_swamp"]
+                .iter()
+                .filter_map(|b| woodland(b).map(|w| w.1))
+                .collect();
+        let (slot, ground) = (16i64, 2i32);
+        let width = (kinds.len() as i64 * slot) as u32;
+        let height = 16u32;
+        let mut img = RgbImage::from_pixel(width * PX, height * PX, Rgb([200, 222, 240]));
+        for (i, &kind) in kinds.iter().enumerate() {
+            // One tree a chunk, trunk in the middle.
+            let tree = Tree::new(7 + i as u64, i as i64 * slot + 7, 8, ground, kind);
+            let mut chunk = UnloadedChunk::with_height(32);
+            let x0 = tree.x.div_euclid(16) * 16;
+            place(&mut chunk, &[tree], x0, 0, 0);
+            for lx in 0..16u32 {
+                let x = x0 + i64::from(lx);
+                if x < i as i64 * slot || x >= (i as i64 + 1) * slot {
+                    continue;
+                }
+                for y in 0..height {
+                    // The nearest block seen from the south (the largest z first).
+                    let seen = (0..16u32).rev().map(|z| chunk.block_state(lx, y, z)).find(|b| !b.is_air());
+                    let c = if y <= ground as u32 { Some(Rgb([104, 160, 72])) } else { seen.and_then(colour) };
+                    if let Some(c) = c {
+                        let (px, py) = (x as u32 * PX, (height - 1 - y) * PX);
+                        for d in 0..PX * PX {
+                            img.put_pixel(px + d % PX, py + d / PX, c);
+                        }
+                    }
+                }
+            }
+        }
+        let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/trees.png");
+        img.save(&out).expect("write docs/trees.png");
     }
 }

@@ -143,7 +143,7 @@ mod tests {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
-        ctx.columns = Some(testing::columns(&g, Rect::new(-4, -4, 24, 24), f));
+        ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), f));
         ctx.biomes = vec![biome; 16 * ctx.cells_y()];
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
         super::super::water::run(&mut ctx, &mut chunk);
@@ -206,7 +206,7 @@ mod tests {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome("minecraft:plains"));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
-        ctx.columns = Some(testing::river_columns(&g, Rect::new(-4, -4, 24, 24), |_, z| {
+        ctx.columns = Some(testing::river_columns(&g, Rect::new(-5, -5, 26, 26), |_, z| {
             if (6..10).contains(&z) {
                 (0.0, 20.0, Some(100.0))
             } else {

@@ -134,7 +134,7 @@ mod tests {
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, seed_chunk.0, seed_chunk.1);
         let (x0, z0) = (ctx.x0, ctx.z0);
-        ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 4, x0 - 4, 24, 24), |x, _| (ground(x), 10.0)));
+        ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 5, x0 - 5, 26, 26), |x, _| (ground(x), 10.0)));
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
         super::super::rock::run(&mut ctx, &mut chunk);
         super::super::water::run(&mut ctx, &mut chunk);
@@ -211,7 +211,7 @@ mod tests {
             for cx in 0..8 {
                 let (chunk, v) = carved((cx, cz), |_| 1000.0);
                 let columns =
-                    testing::columns(&g, Rect::new(i64::from(cz) * 16 - 4, i64::from(cx) * 16 - 4, 24, 24), |_, _| {
+                    testing::columns(&g, Rect::new(i64::from(cz) * 16 - 5, i64::from(cx) * 16 - 5, 26, 26), |_, _| {
                         (1000.0, 10.0)
                     });
                 assert_eq!(columns.surface_y(i64::from(cx) * 16, i64::from(cz) * 16), 103);

@@ -68,7 +68,10 @@ mod tests {
         let mut chunk = UnloadedChunk::with_height(g.vertical().height as u32);
         run(&mut ctx, &mut chunk);
         let r = ctx.columns().rect();
-        assert_eq!((r.x0, r.y0, r.w, r.h), (32 - trees::REACH - 1, -48 - trees::REACH - 1, 24, 24));
+        assert_eq!(
+            (r.x0, r.y0, r.w, r.h),
+            (32 - trees::REACH - 1, -48 - trees::REACH - 1, 16 + 2 * (trees::REACH + 1), 16 + 2 * (trees::REACH + 1))
+        );
         assert_eq!(ctx.biomes.len(), 16 * ctx.cells_y());
         assert!(ctx.biomes.iter().all(|&b| b == "minecraft:forest"));
         assert_eq!(chunk.biome(3, 10, 2), palette.id("minecraft:forest"));

@@ -270,7 +270,7 @@ mod tests {
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, cx, cz);
         let (x0, z0) = (ctx.x0, ctx.z0);
-        ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 4, x0 - 4, 24, 24), |_, _| (2000.0, 10.0)));
+        ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 5, x0 - 5, 26, 26), |_, _| (2000.0, 10.0)));
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
         super::super::rock::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);

@@ -87,7 +87,7 @@ mod tests {
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
         // Ground rising 25 m (one block) per column eastwards from Y 63.
-        ctx.columns = Some(testing::columns(&g, Rect::new(-4, -4, 24, 24), |x, _| (x.max(0) as f32 * 25.0, 10.0)));
+        ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |x, _| (x.max(0) as f32 * 25.0, 10.0)));
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
         run(&mut ctx, &mut chunk);
         let count = |y: i32, block: BlockState| {

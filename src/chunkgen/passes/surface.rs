@@ -53,7 +53,7 @@ mod tests {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
-        let columns = testing::columns(&g, Rect::new(-4, -4, 24, 24), |_, _| (elevation, 15.0));
+        let columns = testing::columns(&g, Rect::new(-5, -5, 26, 26), |_, _| (elevation, 15.0));
         let ground_y = columns.surface_y(5, 5);
         ctx.columns = Some(columns);
         ctx.biomes = vec![biome; 16 * ctx.cells_y()];
@@ -88,7 +88,7 @@ mod tests {
         let (g, palette, rules) =
             (testing::generator(), testing::palette(), testing::single_biome("minecraft:badlands"));
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
-        ctx.columns = Some(testing::columns(&g, Rect::new(-4, -4, 24, 24), |_, _| (-1.0e9, 15.0)));
+        ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |_, _| (-1.0e9, 15.0)));
         ctx.biomes = vec!["minecraft:badlands"; 16 * ctx.cells_y()];
         run(&mut ctx, &mut chunk);
         assert_eq!(chunk.block_state(5, 0, 5), BlockState::BEDROCK);

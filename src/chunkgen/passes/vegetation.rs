@@ -39,7 +39,7 @@ mod tests {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
-        ctx.columns = Some(testing::columns(&g, Rect::new(-4, -4, 24, 24), |_, _| (100.0, 15.0)));
+        ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |_, _| (100.0, 15.0)));
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
         run(&mut ctx, &mut chunk);
         chunk

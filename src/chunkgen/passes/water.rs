@@ -54,7 +54,7 @@ mod tests {
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
         // West half sea 600 m deep (ground Y 52), east half land; the north half is frozen.
-        ctx.columns = Some(testing::columns(&g, Rect::new(-4, -4, 24, 24), |x, z| {
+        ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |x, z| {
             (if x < 8 { -600.0 } else { 100.0 }, if z < 8 { -5.0 } else { 10.0 })
         }));
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
