@@ -172,36 +172,26 @@ pub fn render(config: &Config, sources: &Sources, a: &RenderArgs) -> Result<(), 
         progress.finish();
         return save(&image, &a.out);
     }
-    if a.view == View::Cutaway {
+    // The views drawn from the server's own chunks and columns.
+    let block_view = match a.view {
+        View::Map => None,
+        View::Oblique => Some(("--view oblique draws every block column with its top block", "rows of columns")),
+        View::Cutaway => Some(("--view cutaway draws every block of one row at 3 pixels a block", "chunks")),
+    };
+    if let Some((what, unit)) = block_view {
         if a.zoom != 1 || a.layer != Layer::Elevation {
-            return Err(Failure::input(anyhow::anyhow!(
-                "--view cutaway draws every block of one row at 3 pixels a block: --zoom and --layer do not apply"
-            )));
+            return Err(Failure::input(anyhow::anyhow!("{what}: --zoom and --layer do not apply")));
         }
         let rules = rules.load().map_err(Failure::input)?;
         let generator = Generator::new(std::sync::Arc::new(pipeline(config, &models)?), config);
-        let mut progress = Progress::new("render", "chunks");
-        let image = render::render_cutaway(&generator, &rules, &CutawayRequest { x0, z: z0, width }, &mut |d, t| {
-            progress.update(d, t)
-        })
+        let mut progress = Progress::new("render", unit);
+        let mut report = |d, t| progress.update(d, t);
+        let image = if a.view == View::Oblique {
+            render::render_oblique(&generator, &rules, &ObliqueRequest { x0, z0, width, height }, &mut report)
+        } else {
+            render::render_cutaway(&generator, &rules, &CutawayRequest { x0, z: z0, width }, &mut report)
+        }
         .map_err(|e| classify(e.is_bad_input(), e))?;
-        progress.finish();
-        return save(&image, &a.out);
-    }
-    if a.view == View::Oblique {
-        if a.zoom != 1 || a.layer != Layer::Elevation {
-            return Err(Failure::input(anyhow::anyhow!(
-                "--view oblique draws every block column with its top block: --zoom and --layer do not apply"
-            )));
-        }
-        let rules = rules.load().map_err(Failure::input)?;
-        let generator = Generator::new(std::sync::Arc::new(pipeline(config, &models)?), config);
-        let mut progress = Progress::new("render", "rows of columns");
-        let image =
-            render::render_oblique(&generator, &rules, &ObliqueRequest { x0, z0, width, height }, &mut |d, t| {
-                progress.update(d, t)
-            })
-            .map_err(|e| classify(e.is_bad_input(), e))?;
         progress.finish();
         return save(&image, &a.out);
     }
