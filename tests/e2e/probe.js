@@ -101,10 +101,11 @@ function main () {
   bot.on('physicsTick', check)
 }
 
-// Blocks the generator places on the ground as vegetation (see src/fill/plants.rs).
+// Blocks the generator places on the ground as vegetation (see src/chunkgen/plants.rs), and
+// the layer of snow the snow pass lays over snowy biomes (src/chunkgen/passes/snow.rs).
 const PLANTS = new Set([
   'grass', 'tall_grass', 'fern', 'large_fern', 'dead_bush', 'cactus', 'sunflower', 'dandelion', 'poppy',
-  'cornflower', 'oxeye_daisy', 'azure_bluet', 'allium', 'pink_petals', 'sugar_cane', 'lily_pad'
+  'cornflower', 'oxeye_daisy', 'azure_bluet', 'allium', 'pink_petals', 'sugar_cane', 'lily_pad', 'snow'
 ])
 
 // The ground of column (x, z): its highest block that is neither air, a plant nor part of a tree, with

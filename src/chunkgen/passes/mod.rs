@@ -11,6 +11,7 @@ mod caves;
 mod columns;
 mod ores;
 mod rock;
+mod snow;
 mod surface;
 mod vegetation;
 mod water;
@@ -28,7 +29,7 @@ pub struct Pass {
 }
 
 /// Every pass, in order.
-pub const PASSES: [Pass; 8] = [
+pub const PASSES: [Pass; 9] = [
     // The pipeline's columns around the chunk and the biome of every 4×4×4 cell.
     Pass { name: "columns", run: columns::run },
     // Bedrock, then deepslate and stone up to every column's ground.
@@ -47,6 +48,8 @@ pub const PASSES: [Pass; 8] = [
     Pass { name: "vegetation", run: vegetation::run },
     // Seagrass and kelp in the sea, lily pads on lakes, sugar cane on banks.
     Pass { name: "aquatic", run: aquatic::run },
+    // A layer of snow on the highest block of every column of a snowy biome.
+    Pass { name: "snow", run: snow::run },
 ];
 
 /// Test support: contexts over synthetic columns, for the passes' unit tests.
