@@ -9,6 +9,7 @@
 mod aquatic;
 mod caves;
 mod columns;
+mod icebergs;
 mod ores;
 mod rock;
 mod snow;
@@ -29,7 +30,7 @@ pub struct Pass {
 }
 
 /// Every pass, in order.
-pub const PASSES: [Pass; 9] = [
+pub const PASSES: [Pass; 10] = [
     // The pipeline's columns around the chunk and the biome of every 4×4×4 cell.
     Pass { name: "columns", run: columns::run },
     // Bedrock, then deepslate and stone up to every column's ground.
@@ -48,6 +49,8 @@ pub const PASSES: [Pass; 9] = [
     Pass { name: "vegetation", run: vegetation::run },
     // Seagrass and kelp in the sea, lily pads on lakes, sugar cane on banks.
     Pass { name: "aquatic", run: aquatic::run },
+    // Mounds of packed ice in frozen seas.
+    Pass { name: "icebergs", run: icebergs::run },
     // A layer of snow on the highest block of every column of a snowy biome.
     Pass { name: "snow", run: snow::run },
 ];
