@@ -49,6 +49,7 @@ use crate::terrain::Pipeline;
 pub use chunk::{PassTiming, CHUNK};
 pub use columns::Columns;
 pub use context::ChunkContext;
+pub use hash::unit3;
 pub use light::Light;
 pub use palette::{vanilla_biome_names, BiomePalette};
 pub use plants::is_plant;

@@ -9,7 +9,7 @@
 use std::collections::HashMap;
 
 use image::{Rgb, RgbImage};
-use valence::prelude::Chunk;
+use valence::prelude::{BlockState, Chunk};
 
 use super::biomes::frame;
 use super::RenderError;
@@ -55,7 +55,7 @@ pub fn render_cutaway(
             BLOCK_PIXELS
         ),
     ];
-    Ok(frame(img, &title, counts, |name| to_rgb(colour(name))))
+    Ok(frame(img, &title, counts, colour))
 }
 
 /// The slice's picture (without its legend), the blocks counted by legend entry, and the
@@ -75,7 +75,7 @@ fn slice(
     let (cz, lz) = (req.z.div_euclid(CHUNK) as i32, req.z.rem_euclid(CHUNK) as u32);
     let (c0, c1) = (req.x0.div_euclid(CHUNK), (req.x0 + req.width - 1).div_euclid(CHUNK));
     // Block names of the slice, column by column, from the floor up.
-    let mut names: Vec<Vec<&'static str>> = Vec::with_capacity(req.width as usize);
+    let mut names: Vec<Vec<BlockState>> = Vec::with_capacity(req.width as usize);
     for cx in c0..=c1 {
         let chunk = generator.chunk(rules, &palette, cx as i32, cz);
         for lx in 0..CHUNK {
@@ -83,32 +83,28 @@ fn slice(
             if x < req.x0 || x >= req.x0 + req.width {
                 continue;
             }
-            names.push((0..height as u32).map(|y| chunk.block_state(lx as u32, y, lz).to_kind().to_str()).collect());
+            names.push((0..height as u32).map(|y| chunk.block_state(lx as u32, y, lz)).collect());
         }
         progress((cx - c0 + 1) as u64, (c1 - c0 + 1) as u64);
     }
     // Each column's ground: its highest block that is neither air nor a plant.
-    let solid = |n: &str| !is_air(n) && !is_plant_name(n);
-    let grounds: Vec<usize> = names.iter().map(|col| col.iter().rposition(|n| solid(n)).unwrap_or(0)).collect();
+    let solid = |b: &BlockState| !b.is_air() && !is_plant(*b);
+    let grounds: Vec<usize> = names.iter().map(|col| col.iter().rposition(solid).unwrap_or(0)).collect();
     let top = (grounds.iter().max().copied().unwrap_or(0) + SKY_BLOCKS as usize).min(height - 1);
     let rows = top + 1;
     let mut img = RgbImage::new(req.width as u32 * BLOCK_PIXELS, rows as u32 * BLOCK_PIXELS);
     let mut counts: HashMap<String, u64> = HashMap::new();
     for (i, col) in names.iter().enumerate() {
-        for (y, &name) in col.iter().enumerate().take(rows) {
-            let shown = if is_air(name) {
-                if y < grounds[i] {
-                    "cave"
-                } else {
-                    "sky"
-                }
-            } else {
-                legend_name(name)
+        for (y, &block) in col.iter().enumerate().take(rows) {
+            let shown = match (block.is_air(), y < grounds[i]) {
+                (true, true) => "cave",
+                (true, false) => "sky",
+                (false, _) => legend_name(block),
             };
             if shown != "sky" {
                 *counts.entry(shown.to_string()).or_default() += 1;
             }
-            let colour = to_rgb(colour(shown));
+            let colour = colour(shown);
             let (px, py) = (i as u32 * BLOCK_PIXELS, (top - y) as u32 * BLOCK_PIXELS);
             for dy in 0..BLOCK_PIXELS {
                 for dx in 0..BLOCK_PIXELS {
@@ -120,30 +116,23 @@ fn slice(
     Ok((img, counts, top))
 }
 
-fn is_air(name: &str) -> bool {
-    matches!(name, "air" | "cave_air" | "void_air")
-}
-
-fn is_plant_name(name: &str) -> bool {
-    valence::prelude::BlockKind::from_str(name).is_some_and(|k| is_plant(k.to_state()))
-}
-
 /// The legend entry a block is counted under: deepslate ores with their ore, logs and leaves
 /// as trees, the rest by name.
-fn legend_name(name: &str) -> &str {
+fn legend_name(block: BlockState) -> &'static str {
+    let name = block.to_kind().to_str();
     let ore = name.strip_prefix("deepslate_").filter(|o| o.ends_with("_ore")).unwrap_or(name);
     if ore.ends_with("_log") || ore.ends_with("_leaves") {
         "tree"
-    } else if is_plant_name(name) {
+    } else if is_plant(block) {
         "plant"
     } else {
         ore
     }
 }
 
-/// Colour of a legend entry, 0–255 per channel.
-fn colour(name: &str) -> [u8; 3] {
-    match name {
+/// Colour of a legend entry.
+fn colour(name: &str) -> Rgb<u8> {
+    Rgb(match name {
         "sky" => [200, 222, 240],
         "cave" => [24, 22, 28],
         "stone" => [125, 125, 125],
@@ -171,11 +160,7 @@ fn colour(name: &str) -> [u8; 3] {
         "tree" => [60, 110, 40],
         "plant" => [120, 190, 90],
         _ => [200, 100, 200],
-    }
-}
-
-fn to_rgb(c: [u8; 3]) -> Rgb<u8> {
-    Rgb(c)
+    })
 }
 
 #[cfg(test)]
@@ -196,8 +181,8 @@ mod tests {
         assert!(!counts.contains_key("sky"), "sky is not counted");
         // The floor is bedrock; the top row is sky.
         let bottom = img.get_pixel(0, img.height() - 1);
-        assert_eq!(*bottom, to_rgb(colour("bedrock")));
-        assert_eq!(*img.get_pixel(0, 0), to_rgb(colour("sky")));
+        assert_eq!(*bottom, colour("bedrock"));
+        assert_eq!(*img.get_pixel(0, 0), colour("sky"));
     }
 
     #[test]
@@ -209,9 +194,9 @@ mod tests {
 
     #[test]
     fn ores_are_counted_with_their_deepslate_variants_and_trees_as_one() {
-        assert_eq!(legend_name("deepslate_diamond_ore"), "diamond_ore");
-        assert_eq!(legend_name("deepslate"), "deepslate");
-        assert_eq!(legend_name("oak_leaves"), "tree");
+        assert_eq!(legend_name(BlockState::DEEPSLATE_DIAMOND_ORE), "diamond_ore");
+        assert_eq!(legend_name(BlockState::DEEPSLATE), "deepslate");
+        assert_eq!(legend_name(BlockState::OAK_LEAVES), "tree");
         assert_ne!(colour("diamond_ore"), colour("lapis_ore"));
         assert_ne!(colour("cave"), colour("sky"));
     }

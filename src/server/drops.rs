@@ -17,6 +17,10 @@ use valence::prelude::*;
 use valence::protocol::packets::play::ItemPickupAnimationS2c;
 use valence::protocol::{VarInt, WritePacket};
 
+use crate::chunkgen::unit3;
+
+/// Salt of the draws that vary a drop's count (the world's seed plays no part).
+const DROP_SALT: u64 = 0xD209_5EED;
 /// Ticks before a drop can be picked up (vanilla's pickup delay, half a second).
 const PICKUP_DELAY: u32 = 10;
 /// Ticks a drop lies before it vanishes (vanilla's five minutes).
@@ -47,7 +51,7 @@ pub fn drop_of(block: BlockState, tool: Option<ItemKind>, pos: BlockPos) -> Opti
         return None;
     }
     // A draw in [0, 1) fixed by the block and its place.
-    let draw = unit(pos, block.to_raw());
+    let draw = f64::from(unit3(DROP_SALT, u64::from(block.to_raw()), pos.x.into(), pos.y.into(), pos.z.into()));
     let between = |lo: u8, hi: u8| lo + (draw * f64::from(hi - lo + 1)) as u8;
     let item = |n: &str| ItemKind::from_str(n);
     let ore = name.strip_prefix("deepslate_").unwrap_or(name);
@@ -147,18 +151,6 @@ fn pickaxe_tier(tool: Option<ItemKind>) -> u8 {
         Some("diamond_pickaxe" | "netherite_pickaxe") => 4,
         _ => 0,
     }
-}
-
-/// A number in [0, 1) fixed by a block position and a salt.
-fn unit(pos: BlockPos, salt: u16) -> f64 {
-    let mut h = (pos.x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ (pos.y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
-        ^ (pos.z as u64).wrapping_mul(0x1656_67B1_9E37_79F9)
-        ^ u64::from(salt);
-    h ^= h >> 33;
-    h = h.wrapping_mul(0xFF51_AFD7_ED55_8CCD);
-    h ^= h >> 33;
-    (h >> 11) as f64 / (1u64 << 53) as f64
 }
 
 /// The item `client` holds in its main hand.

@@ -18,6 +18,10 @@ pub fn snowy(biome: &str) -> bool {
 
 /// Lays the snow.
 pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+    // Most chunks have no snowy cell at all: skip their columns' biome lookups.
+    if !ctx.biomes.iter().any(|b| snowy(b)) {
+        return;
+    }
     let (g, v, columns) = (ctx.generator, *ctx.vertical(), ctx.columns());
     let height = chunk.height() as i32;
     for (lx, lz, x, z) in ctx.each_column() {
