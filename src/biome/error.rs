@@ -62,6 +62,16 @@ pub enum BiomeError {
         /// What is wrong.
         problem: Box<Problem>,
     },
+    /// Something wrong in one biome's `[vegetation."…"]` table.
+    #[error("{at}: vegetation for \"{biome}\": {problem}")]
+    Vegetation {
+        /// The table's header, or the offending key.
+        at: Location,
+        /// The biome as the header names it.
+        biome: String,
+        /// What is wrong.
+        problem: Box<Problem>,
+    },
     /// No file sets `fallback`, so some conditions would have no biome.
     #[error(
         "{}:1: no rule file sets `fallback = \"minecraft:...\"`: exactly one must name the biome used where \
@@ -78,7 +88,10 @@ impl BiomeError {
     /// The location the message points at, when there is one (tests and tooling).
     pub fn location(&self) -> Option<&Location> {
         match self {
-            BiomeError::Syntax { at, .. } | BiomeError::Rule { at, .. } | BiomeError::Fallback { at, .. } => Some(at),
+            BiomeError::Syntax { at, .. }
+            | BiomeError::Rule { at, .. }
+            | BiomeError::Fallback { at, .. }
+            | BiomeError::Vegetation { at, .. } => Some(at),
             BiomeError::Read { .. } | BiomeError::NoFiles { .. } | BiomeError::NoFallback { .. } => None,
         }
     }
@@ -162,6 +175,39 @@ pub enum Problem {
     #[error("set again; it is already set at {first} (exactly one file may set it)")]
     FallbackTwice {
         /// The first setting.
+        first: Location,
+    },
+    /// A species or plant name a vegetation table does not know.
+    #[error("unknown {what} \"{name}\"{}", did_you_mean(.suggestion, "\""))]
+    UnknownName {
+        /// `species` or `plant`.
+        what: &'static str,
+        /// The name as written.
+        name: String,
+        /// The closest known name.
+        suggestion: Option<&'static str>,
+    },
+    /// A biome's plant chances add up to more than one plant per column.
+    #[error("the plant chances sum to {total:.2}, more than 1: a column grows one plant at most")]
+    PlantsOverOne {
+        /// Their sum.
+        total: f64,
+    },
+    /// A chance outside `[0, 1]`.
+    #[error("`{key}` must be from 0 to 1, not {value}")]
+    BadChance {
+        /// The key or plant.
+        key: String,
+        /// The value as written.
+        value: f64,
+    },
+    /// Trees are asked for, but no species says which.
+    #[error("`trees` above 0 needs `species`, such as species = {{ oak = 1 }}")]
+    TreesWithoutSpecies,
+    /// A biome's vegetation given a second time.
+    #[error("already given at {first} (one table per biome, over all files)")]
+    VegetationTwice {
+        /// The first table.
         first: Location,
     },
 }

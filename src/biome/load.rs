@@ -12,6 +12,7 @@ use toml::{Spanned, Value};
 use super::error::{BiomeError, Location, Problem};
 use super::names::{overworld_biome, suggest_biome, suggest_key};
 use super::rules::{Axis, Bounds, Table};
+use super::vegetation;
 use super::WaterBody;
 
 /// Shorthand for `surface_m` measured downwards, so ocean rules read like ocean charts.
@@ -45,6 +46,8 @@ struct RawFile {
     fallback: Option<Spanned<String>>,
     #[serde(default)]
     rule: Vec<Spanned<BTreeMap<Spanned<String>, Spanned<Value>>>>,
+    #[serde(default)]
+    vegetation: vegetation::RawTables,
 }
 
 /// A rule as loaded: its box and what messages need to point at it.
@@ -65,12 +68,14 @@ pub(crate) struct Rule {
 pub(crate) struct Loaded {
     pub(crate) rules: Vec<Rule>,
     pub(crate) table: Table,
+    pub(crate) vegetation: vegetation::Table,
 }
 
 /// Parses and checks `files` in the order given (the caller sorts by name).
 pub(crate) fn load(files: &[(PathBuf, String)]) -> Result<Loaded, BiomeError> {
     let mut rules = Vec::new();
     let mut fallback: Option<(&'static str, Location)> = None;
+    let mut vegetation = vegetation::Builder::default();
     for (file, text) in files {
         let raw: RawFile = toml::from_str(text).map_err(|e| BiomeError::Syntax {
             at: Location { file: file.clone(), line: e.span().map_or(1, |s| line_of(text, s.start)) },
@@ -93,6 +98,7 @@ pub(crate) fn load(files: &[(PathBuf, String)]) -> Result<Loaded, BiomeError> {
         for (index, table) in raw.rule.iter().enumerate() {
             rules.push(parse_rule(file, text, index, table)?);
         }
+        vegetation.add(file, text, &raw.vegetation)?;
     }
     let Some((fallback, _)) = fallback else {
         return Err(BiomeError::NoFallback { file: files.first().map(|(f, _)| f.clone()).unwrap_or_default() });
@@ -104,7 +110,7 @@ pub(crate) fn load(files: &[(PathBuf, String)]) -> Result<Loaded, BiomeError> {
         biomes: rules.iter().map(|r| r.biome).collect(),
         fallback,
     };
-    Ok(Loaded { rules, table })
+    Ok(Loaded { rules, table, vegetation: vegetation.finish() })
 }
 
 /// The parser's message, with a hint for the one mistake it words obscurely: `[rule]`
@@ -119,7 +125,7 @@ fn syntax_message(message: &str) -> String {
 }
 
 /// 1-based line of byte `offset`.
-fn line_of(text: &str, offset: usize) -> usize {
+pub(crate) fn line_of(text: &str, offset: usize) -> usize {
     text.as_bytes()[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
 }
 

@@ -7,6 +7,10 @@
 //! the server's reload command (it only offers a load that either fully succeeds or changes
 //! nothing), Minecraft registries beyond names.
 //!
+//! Beside the rules, `[vegetation."minecraft:…"]` tables (shipped in
+//! `biomes/vegetation.toml`, documented at its top) say what grows in each biome: how wooded
+//! it is, which tree species in what shares, and the chance of each ground plant.
+//!
 //! Semantics in one paragraph: files are read in file-name order and their rules
 //! concatenated; a rule is a box of half-open ranges `[min, max)`, one per quantity it names;
 //! the first rule whose box holds the conditions gives the biome, and the configured
@@ -18,6 +22,7 @@ mod error;
 mod load;
 mod names;
 mod rules;
+mod vegetation;
 
 #[cfg(test)]
 mod default_tests;
@@ -28,6 +33,7 @@ use std::path::{Path, PathBuf};
 
 pub use error::{BiomeError, Location, Problem};
 pub use names::OVERWORLD_BIOMES;
+pub use vegetation::{Species, Vegetation, PLANTS};
 
 /// What a rule sees for one 4×4×4 biome cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,6 +109,8 @@ pub struct BiomeRules {
     table: rules::Table,
     /// Names of the rules, parallel to the table (for [`BiomeRules::matching_rule`]).
     names: Vec<String>,
+    /// What grows in each biome.
+    vegetation: vegetation::Table,
 }
 
 impl BiomeRules {
@@ -136,7 +144,11 @@ impl BiomeRules {
     /// Builds rules from `(name, contents)` pairs, in the order given (tests, embedded rules).
     pub fn from_sources(files: &[(PathBuf, String)]) -> Result<BiomeRules, BiomeError> {
         let loaded = load::load(files)?;
-        Ok(BiomeRules { table: loaded.table, names: loaded.rules.into_iter().map(|r| r.name).collect() })
+        Ok(BiomeRules {
+            table: loaded.table,
+            names: loaded.rules.into_iter().map(|r| r.name).collect(),
+            vegetation: loaded.vegetation,
+        })
     }
 
     /// The biome for `c`, e.g. `"minecraft:plains"`: the first matching rule's, else the
@@ -160,6 +172,12 @@ impl BiomeRules {
         names.sort_unstable();
         names.dedup();
         names
+    }
+
+    /// What grows in `biome` (trees, their species, ground plants), or `None` where no
+    /// `[vegetation."…"]` table names it: nothing grows there.
+    pub fn vegetation(&self, biome: &str) -> Option<&Vegetation> {
+        self.vegetation.get(biome)
     }
 
     /// The biome used where no rule matches.

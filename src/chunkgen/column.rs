@@ -55,7 +55,7 @@ impl Generator {
             if ground.top.is_liquid() {
                 return None;
             }
-            plants::candidate(self.seed, biome, ground.top, x, z).map(|p| (ground_y + 1, p))
+            plants::candidate(self.seed, rules.vegetation(biome), ground.top, x, z).map(|p| (ground_y + 1, p))
         };
         let (base_y, plant) = candidate(x, z)?;
         if base_y + plant.blocks().len() as i32 > v.min_y + v.height {
@@ -80,7 +80,7 @@ impl Generator {
         let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
         self.trees(rules, &columns, x, z, 1)
             .iter()
-            .all(|t| (t.x - x).abs() >= trees::REACH || (t.z - z).abs() >= trees::REACH)
+            .all(|t| (t.x - x).abs() > trees::REACH || (t.z - z).abs() > trees::REACH)
     }
 
     /// Every tree rooted within reach of the `size`×`size` square at (`x0`, `z0`), in global
@@ -89,27 +89,29 @@ impl Generator {
         debug_assert!(columns.rect().contains_rect(&tree_rect(x0, z0, size)));
         let v = &self.vertical;
         let mut trees = Vec::new();
-        for (x, z, chance) in trees::candidate_roots(self.seed, x0, z0, size) {
+        for (x, z, chance, draw) in trees::candidate_roots(self.seed, x0, z0, size) {
             let biome = self.surface_biome(rules, columns, x, z);
-            let Some((density, kind)) = trees::woodland(biome) else { continue };
-            if chance >= density {
+            let Some(vegetation) = rules.vegetation(biome) else { continue };
+            if chance >= vegetation.trees {
                 continue;
             }
+            let Some(species) = vegetation.species(draw) else { continue };
             let ground_y = columns.surface_y(x, z);
             let ground = self.ground_at(columns, biome, x, z);
             let dry = !columns.is_wet(x, z) && !ground.top.is_liquid();
             let rooted = !cave_field::may_open(self.seed, columns, x, z);
             if dry && rooted && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top)
             {
-                // A 2×2 trunk needs its other three columns level, dry and whole.
-                let even = Tree::extra_trunk_columns(kind).iter().all(|&(dx, dz)| {
-                    let (x, z) = (x + dx, z + dz);
-                    columns.surface_y(x, z) == ground_y
-                        && !columns.is_wet(x, z)
-                        && !cave_field::may_open(self.seed, columns, x, z)
-                });
-                let kind = if even { kind } else { Tree::small_dark_oak() };
-                let tree = Tree::new(self.seed, x, z, ground_y, kind);
+                // A 2×2 trunk needs its other three columns level, dry and whole; where they
+                // are not, the species grows in its one-column form.
+                let wide = trees::is_wide(species)
+                    && trees::WIDE_TRUNK.iter().all(|&(dx, dz)| {
+                        let (x, z) = (x + dx, z + dz);
+                        columns.surface_y(x, z) == ground_y
+                            && !columns.is_wet(x, z)
+                            && !cave_field::may_open(self.seed, columns, x, z)
+                    });
+                let tree = Tree::new(self.seed, x, z, ground_y, species, wide);
                 if tree.top_y() < v.min_y + v.height {
                     trees.push(tree);
                 }

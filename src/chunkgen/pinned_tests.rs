@@ -119,14 +119,16 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 /// [`hash_region`] of every region in [`PROCEDURAL_REGIONS`] (on the default configuration's
 /// world with the shipped biome rules) outside the shallow sea, re-recorded when ore veins
 /// took vanilla's mean block counts (granite blobs of ~685 blocks, diamond veins of ~2), and
-/// again for acacias that bend and 2×2 dark oaks (trees reach 4 blocks from their trunk).
-const OUTSIDE_SHALLOWS_HASH: u64 = 0xd31a_73f7_fd4d_e58c;
+/// again for acacias that bend and 2×2 dark oaks (trees reach 4 blocks from their trunk), and
+/// again when vegetation became data (`biomes/vegetation.toml`: sixteen species by weight,
+/// every plant by name) and warm seas grew coral.
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xf341_7c5c_fff3_4277;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded as above.
-const PROCEDURAL_HASH: u64 = 0x5293_136a_093f_83c5;
+const PROCEDURAL_HASH: u64 = 0xd7d9_3426_e559_1651;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]
-const LEARNED_HASH: u64 = 0x5671_a047_4730_b037;
+const LEARNED_HASH: u64 = 0xba52_ea1e_93f1_3a74;
 
 fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();

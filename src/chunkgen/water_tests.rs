@@ -239,10 +239,7 @@ fn assert_no_dry_sea(r: &Region, v: &Vertical) {
         for y in ground + 1..=v.water_top_y() {
             let b = r.block(x, y, z).unwrap();
             assert!(
-                is_water(b)
-                    || b == BlockState::ICE
-                    || b.to_kind().to_str().contains("kelp")
-                    || b == BlockState::SEAGRASS,
+                is_water(b) || b == BlockState::ICE || super::passes::is_sea_growth(b),
                 "dry sea column at ({x}, {y}, {z}): {b:?}"
             );
         }

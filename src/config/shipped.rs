@@ -1,5 +1,5 @@
 //! What the repository ships, compiled into the binary so an installed `infiniterra` runs
-//! from any directory: the configuration file, the default biome rules and the trained
+//! from any directory: the configuration file, the default biome rules and vegetation, and the trained
 //! models (a few MB). A file on disk always wins over these (the lookup order is in
 //! [`find`](super::find)).
 
@@ -12,11 +12,22 @@ pub const CONFIG: &str = include_str!("../../config/server.toml");
 /// The name the built-in configuration goes by in messages.
 pub const CONFIG_NAME: &str = "built-in config/server.toml";
 
-/// `biomes/default.toml` as shipped.
+/// `biomes/default.toml` as shipped: the biome rules.
 pub const BIOMES: &str = include_str!("../../biomes/default.toml");
 
-/// The name the built-in biome rules go by in messages.
-pub const BIOMES_NAME: &str = "built-in biomes/default.toml";
+/// `biomes/vegetation.toml` as shipped: what grows in each biome.
+pub const VEGETATION: &str = include_str!("../../biomes/vegetation.toml");
+
+/// The name the built-in biome files go by in messages (each message adds the file).
+pub const BIOMES_NAME: &str = "built-in biomes/";
+
+/// Every shipped biome file as (name for messages, text), in the order they load.
+pub fn biome_sources() -> Vec<(std::path::PathBuf, String)> {
+    [("default.toml", BIOMES), ("vegetation.toml", VEGETATION)]
+        .into_iter()
+        .map(|(name, text)| (std::path::PathBuf::from(format!("{BIOMES_NAME}{name}")), text.to_string()))
+        .collect()
+}
 
 /// Every file of `models/` the learned stages read: manifests and weights.
 static MODELS: [(&str, &[u8]); 6] = [

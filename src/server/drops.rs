@@ -76,13 +76,22 @@ pub fn drop_of(block: BlockState, tool: Option<ItemKind>, pos: BlockPos) -> Opti
         "melon" => (item("melon_slice")?, between(3, 7)),
         "bookshelf" => (item("book")?, 3),
         "dead_bush" => (item("stick")?, between(0, 2)),
+        "cocoa" => (item("cocoa_beans")?, between(2, 3)),
+        "sweet_berry_bush" => (item("sweet_berries")?, between(2, 3)),
+        // Vines need shears (not in play yet).
+        "vine" => return None,
         // Grass gives seeds one time in eight.
         "grass" | "tall_grass" | "fern" | "large_fern" if draw < 0.125 => (item("wheat_seeds")?, 1),
         "grass" | "tall_grass" | "fern" | "large_fern" | "ice" | "packed_ice" | "blue_ice" | "glass" | "glass_pane"
         | "budding_amethyst" => return None,
         _ if name.ends_with("_leaves") => {
             // A sapling one time in twenty; the rest nothing (no shears in play yet).
-            let sapling = name.replace("_leaves", "_sapling");
+            let sapling = match name {
+                "mangrove_leaves" => "mangrove_propagule".to_string(),
+                "azalea_leaves" => "azalea".to_string(),
+                "flowering_azalea_leaves" => "flowering_azalea".to_string(),
+                _ => name.replace("_leaves", "_sapling"),
+            };
             return (draw < 0.05).then(|| item(&sapling).map(|k| (k, 1))).flatten();
         }
         _ if name.ends_with("_glass") || name.ends_with("_glass_pane") => return None,
@@ -302,6 +311,17 @@ mod tests {
         assert!(lapis.contains(&4) && lapis.contains(&9), "the whole range is drawn");
         // The same block in the same place drops the same.
         assert_eq!(drop_of(BlockState::LAPIS_ORE, stone, at(7)), drop_of(BlockState::LAPIS_ORE, stone, at(7)));
+    }
+
+    #[test]
+    fn jungle_and_berry_harvests_and_the_saplings_of_odd_leaves() {
+        let beans = drop_of(BlockState::COCOA, None, at(1)).map(|d| d.0);
+        assert_eq!(beans, Some(ItemKind::CocoaBeans));
+        assert_eq!(drop_of(BlockState::SWEET_BERRY_BUSH, None, at(1)).map(|d| d.0), Some(ItemKind::SweetBerries));
+        assert_eq!(drop_of(BlockState::VINE, None, at(1)), None);
+        let sapling = |leaves: BlockState| (0..400).find_map(|x| drop_of(leaves, None, at(x))).map(|d| d.0);
+        assert_eq!(sapling(BlockState::MANGROVE_LEAVES), Some(ItemKind::MangrovePropagule));
+        assert_eq!(sapling(BlockState::FLOWERING_AZALEA_LEAVES), Some(ItemKind::FloweringAzalea));
     }
 
     #[test]

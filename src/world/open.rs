@@ -22,7 +22,8 @@ use super::Store;
 pub enum RulesSource {
     /// Every `*.toml` of a folder (re-read by the console's `reload`).
     Dir(PathBuf),
-    /// The shipped `biomes/default.toml`, compiled into the binary (nothing to re-read).
+    /// The shipped biome files (`biomes/default.toml`, `biomes/vegetation.toml`), compiled
+    /// into the binary (nothing to re-read).
     BuiltIn,
 }
 
@@ -31,9 +32,7 @@ impl RulesSource {
     pub fn load(&self) -> Result<BiomeRules, WorldError> {
         let rules = match self {
             RulesSource::Dir(dir) => BiomeRules::load_dir(dir),
-            RulesSource::BuiltIn => {
-                BiomeRules::from_sources(&[(PathBuf::from(shipped::BIOMES_NAME), shipped::BIOMES.to_string())])
-            }
+            RulesSource::BuiltIn => BiomeRules::from_sources(&shipped::biome_sources()),
         }
         .map_err(WorldError::Rules)?;
         check_biome_names(&rules)?;

@@ -35,8 +35,10 @@ DIMENSION = "minecraft:overworld"
 AIR = {"air", "cave_air", "void_air"}
 WATERY = {"water", "ice"}
 NOT_GROUND = AIR | WATERY | {
-    "grass", "tall_grass", "fern", "large_fern", "dead_bush", "cactus", "sunflower", "dandelion", "poppy",
-    "cornflower", "oxeye_daisy", "azure_bluet", "allium", "pink_petals", "snow"}
+    "grass", "tall_grass", "fern", "large_fern", "dead_bush", "cactus", "sunflower", "lilac", "rose_bush", "peony",
+    "dandelion", "poppy", "blue_orchid", "allium", "azure_bluet", "red_tulip", "orange_tulip", "white_tulip",
+    "pink_tulip", "oxeye_daisy", "cornflower", "lily_of_the_valley", "pink_petals", "sweet_berry_bush",
+    "brown_mushroom", "red_mushroom", "bamboo", "azalea", "flowering_azalea", "snow", "vine", "cocoa"}
 SEA_REACH = 4
 
 
@@ -100,8 +102,10 @@ def main(argv):
         level.close()
     names = sorted(codes, key=codes.get)
     is_in = lambda group: np.isin(area, [codes[n] for n in group if n in codes])  # noqa: E731
-    not_ground = is_in(NOT_GROUND)
-    # Ground: the highest block of each column that is not in NOT_GROUND.
+    # Trees stand on the ground; they are not it (nor is the air under their crowns).
+    trees = {n for n in codes if n.endswith(("_log", "_leaves")) or n == "mangrove_roots"}
+    not_ground = is_in(NOT_GROUND | trees)
+    # Ground: the highest block of each column that is neither in NOT_GROUND nor a tree.
     ground = np.full((nz, nx), -1)
     for y in range(height):
         ground[~not_ground[y]] = y

@@ -104,9 +104,14 @@ function main () {
 // Blocks the generator places on the ground as vegetation (see src/chunkgen/plants.rs), and
 // the layer of snow the snow pass lays over snowy biomes (src/chunkgen/passes/snow.rs).
 const PLANTS = new Set([
-  'grass', 'tall_grass', 'fern', 'large_fern', 'dead_bush', 'cactus', 'sunflower', 'dandelion', 'poppy',
-  'cornflower', 'oxeye_daisy', 'azure_bluet', 'allium', 'pink_petals', 'sugar_cane', 'lily_pad', 'snow'
+  'grass', 'tall_grass', 'fern', 'large_fern', 'dead_bush', 'cactus', 'sunflower', 'lilac', 'rose_bush', 'peony',
+  'dandelion', 'poppy', 'blue_orchid', 'allium', 'azure_bluet', 'red_tulip', 'orange_tulip', 'white_tulip',
+  'pink_tulip', 'oxeye_daisy', 'cornflower', 'lily_of_the_valley', 'pink_petals', 'sweet_berry_bush',
+  'brown_mushroom', 'red_mushroom', 'bamboo', 'azalea', 'flowering_azalea', 'sugar_cane', 'lily_pad', 'snow'
 ])
+
+// Blocks of trees besides logs and leaves (src/chunkgen/trees.rs).
+const TREE_PARTS = new Set(['mangrove_roots', 'vine', 'cocoa'])
 
 // The ground of column (x, z): its highest block that is neither air, a plant nor part of a tree, with
 // its biome and sky light, and whether anything (a tree) stands above it; null when the
@@ -119,7 +124,7 @@ function topOf (bot, x, z, lit) {
     if (block === null) return null
     if (block.name === 'air' || block.name === 'cave_air' || block.name === 'void_air') continue
     if (PLANTS.has(block.name)) continue // vegetation stands on the ground, it is not the ground
-    if (block.name.endsWith('_log') || block.name.endsWith('_leaves')) {
+    if (block.name.endsWith('_log') || block.name.endsWith('_leaves') || TREE_PARTS.has(block.name)) {
       covered = true
       continue
     }

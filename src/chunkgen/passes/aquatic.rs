@@ -1,5 +1,6 @@
 //! The aquatic pass: what grows by and in water, once the ground, the water and the land's
-//! plants are in place: seagrass and kelp on sea floors that are not frozen, lily pads on
+//! plants are in place: seagrass and kelp on sea floors that are not frozen, coral reefs in
+//! warm seas, lily pads on
 //! lakes and slow rivers in mild climates, sugar cane on the banks where ground meets water,
 //! mangrove roots in the shallow water of mangrove swamps.
 //!
@@ -10,13 +11,15 @@ use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
 
 use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::columns::Water;
-use crate::chunkgen::hash::{hash3, unit3};
+use crate::chunkgen::hash::{hash3, unit3, value_noise};
 use crate::chunkgen::surface::SEA_ICE_C;
 use crate::chunkgen::ChunkContext;
 use crate::terrain::pipeline::channel;
 
 const SALT_AQUATIC: u64 = 0x6171_7561;
 const SALT_HEIGHT: u64 = 0x6865_6967;
+const SALT_REEF: u64 = 0x7265_6566;
+const SALT_CORAL: u64 = 0x636f_7261;
 
 /// Chance of seagrass on a sea floor column 2–12 blocks deep.
 pub const SEAGRASS_CHANCE: f32 = 0.3;
@@ -27,6 +30,28 @@ pub const KELP_CHANCE: f32 = 0.06;
 pub const KELP_MIN_DEPTH: i32 = 5;
 /// The warmest sea kelp grows in, °C (warm oceans have coral instead).
 pub const KELP_MAX_C: f32 = 24.0;
+/// The coolest sea coral reefs grow in, °C (vanilla's warm ocean).
+pub const CORAL_MIN_C: f32 = KELP_MAX_C;
+/// The deepest water reefs grow in, blocks.
+pub const CORAL_MAX_DEPTH: i32 = 16;
+/// Width of reef patches, blocks, and the share of the warm shallow floor they cover (about).
+const REEF_SCALE: i64 = 12;
+const REEF_THRESHOLD: f32 = 0.55;
+/// The corals, by their block ids' first word.
+const CORALS: [(BlockState, BlockState, BlockState); 5] = [
+    (BlockState::TUBE_CORAL_BLOCK, BlockState::TUBE_CORAL, BlockState::TUBE_CORAL_FAN),
+    (BlockState::BRAIN_CORAL_BLOCK, BlockState::BRAIN_CORAL, BlockState::BRAIN_CORAL_FAN),
+    (BlockState::BUBBLE_CORAL_BLOCK, BlockState::BUBBLE_CORAL, BlockState::BUBBLE_CORAL_FAN),
+    (BlockState::FIRE_CORAL_BLOCK, BlockState::FIRE_CORAL, BlockState::FIRE_CORAL_FAN),
+    (BlockState::HORN_CORAL_BLOCK, BlockState::HORN_CORAL, BlockState::HORN_CORAL_FAN),
+];
+
+/// True for what the sea floor grows (seagrass, kelp, coral): under water, not the ground.
+pub fn is_sea_growth(block: BlockState) -> bool {
+    let name = block.to_kind().to_str();
+    block == BlockState::SEAGRASS || name.starts_with("kelp") || name.contains("coral")
+}
+
 /// Chance of a lily pad on a lake or slow river column.
 pub const LILY_PAD_CHANCE: f32 = 0.05;
 /// The fastest river lily pads float on, m³/s.
@@ -79,7 +104,25 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                 if !floor || chunk.block_state(lx, ly(ground + 1), lz) != BlockState::WATER {
                     continue;
                 }
-                if depth >= KELP_MIN_DEPTH && temperature < KELP_MAX_C && roll < KELP_CHANCE {
+                let reef = temperature >= CORAL_MIN_C
+                    && (3..=CORAL_MAX_DEPTH).contains(&depth)
+                    && value_noise(seed, SALT_REEF, x, z, REEF_SCALE) > REEF_THRESHOLD;
+                if reef {
+                    // One or two coral blocks, and on most a coral or a fan, at least two
+                    // blocks under the surface; the colours mix as in vanilla's reefs.
+                    let h = hash3(seed, SALT_CORAL, x, 0, z);
+                    let block = CORALS[(h % 5) as usize].0;
+                    let (top_y, tall) = (water_top - 2, 1 + (h >> 8) as i32 % 2);
+                    let mound = (ground + tall).min(top_y - 1);
+                    for y in ground + 1..=mound {
+                        chunk.set_block_state(lx, ly(y), lz, block);
+                    }
+                    if roll < 0.7 && mound < top_y {
+                        let (coral, fan) = (CORALS[(h >> 16) as usize % 5].1, CORALS[(h >> 24) as usize % 5].2);
+                        let grows = if (h >> 32) % 3 == 0 { fan } else { coral };
+                        chunk.set_block_state(lx, ly(mound + 1), lz, grows);
+                    }
+                } else if depth >= KELP_MIN_DEPTH && temperature < KELP_MAX_C && roll < KELP_CHANCE {
                     // A stalk that stops at least two blocks under the surface.
                     let tall = 1 + (hash3(seed, SALT_HEIGHT, x, 0, z) % (depth - 2).clamp(1, 12) as u64) as i32;
                     for y in ground + 1..ground + tall {
@@ -140,10 +183,20 @@ mod tests {
     /// Runs the rock-less passes that aquatic plants need (water, surface) over synthetic
     /// columns, then this pass.
     fn grow(f: impl Fn(i64, i64) -> (f32, f32), biome: &str) -> (UnloadedChunk, crate::chunkgen::Vertical) {
+        grow_at((0, 0), f, biome)
+    }
+
+    /// [`grow`] for chunk (`cx`, `cz`).
+    fn grow_at(
+        (cx, cz): (i32, i32),
+        f: impl Fn(i64, i64) -> (f32, f32),
+        biome: &str,
+    ) -> (UnloadedChunk, crate::chunkgen::Vertical) {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
-        let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
-        ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), f));
+        let mut ctx = ChunkContext::new(&g, &rules, &palette, cx, cz);
+        let (x0, z0) = (i64::from(cx) * 16, i64::from(cz) * 16);
+        ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 5, x0 - 5, 26, 26), f));
         ctx.biomes = vec![biome; 16 * ctx.cells_y()];
         let mut chunk = UnloadedChunk::with_height(v.height as u32);
         super::super::water::run(&mut ctx, &mut chunk);
@@ -175,6 +228,43 @@ mod tests {
         }
         let (frozen, v) = grow(|_, _| (-200.0, -5.0), "minecraft:frozen_ocean");
         assert_eq!(count(&frozen, &v, BlockState::SEAGRASS) + count(&frozen, &v, BlockState::KELP), 0);
+    }
+
+    #[test]
+    fn warm_seas_grow_coral_reefs_under_the_water_and_cooler_seas_none() {
+        let (mut blocks, mut plants) = (0, 0);
+        for chunk in [(0, 0), (1, 0), (0, 1), (-1, -1)] {
+            let (reef, v) = grow_at(chunk, |_, _| (-500.0, 27.0), "minecraft:warm_ocean");
+            for (x, z) in (0..16u32).flat_map(|x| (0..16u32).map(move |z| (x, z))) {
+                for y in 1..v.height as u32 - 2 {
+                    let b = reef.block_state(x, y, z);
+                    let name = b.to_kind().to_str();
+                    if !name.contains("coral") {
+                        continue;
+                    }
+                    if name.ends_with("_block") {
+                        blocks += 1;
+                    } else {
+                        plants += 1;
+                        // A coral or fan stands on its reef or the floor, waterlogged.
+                        assert_eq!(b.get(PropName::Waterlogged), Some(PropValue::True), "{name}");
+                        assert_ne!(reef.block_state(x, y - 1, z), BlockState::WATER, "a floating {name}");
+                    }
+                    // At least two blocks of water over every reef.
+                    let above = [reef.block_state(x, y + 1, z), reef.block_state(x, y + 2, z)];
+                    assert!(above.iter().all(|&a| a == BlockState::WATER || is_sea_growth(a)), "{name}: {above:?}");
+                }
+            }
+        }
+        assert!(blocks > 20 && plants > 20, "{blocks} coral blocks, {plants} corals");
+        let (cool, v) = grow(|_, _| (-200.0, 15.0), "minecraft:ocean");
+        let corals = (0..16u32)
+            .flat_map(|x| (0..16u32).map(move |z| (x, z)))
+            .flat_map(|(x, z)| (0..v.height as u32).map(move |y| (x, y, z)));
+        assert_eq!(
+            corals.filter(|&(x, y, z)| cool.block_state(x, y, z).to_kind().to_str().contains("coral")).count(),
+            0
+        );
     }
 
     #[test]

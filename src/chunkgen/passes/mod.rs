@@ -21,6 +21,8 @@ use valence::prelude::UnloadedChunk;
 
 use super::ChunkContext;
 
+pub use aquatic::is_sea_growth;
+
 /// One pass: a name (for timings) and the function that runs it on a chunk.
 pub struct Pass {
     /// Short name (`"rock"`), as benchmarks report it.
@@ -77,7 +79,8 @@ pub(crate) mod testing {
 
     /// The rule set of the generator's tests: sea, cold, dry and steep rules over a fallback.
     pub fn rules() -> BiomeRules {
-        BiomeRules::from_sources(&[(PathBuf::from("test.toml"), RULES.to_string())]).expect("test rules load")
+        BiomeRules::from_sources(&[(PathBuf::from("test.toml"), RULES.to_string()), vegetation()])
+            .expect("test rules load")
     }
 
     /// The text of [`rules`].
@@ -102,10 +105,15 @@ biome = "minecraft:windswept_hills"
 slope_deg = [8, 90]
 "#;
 
-    /// Rules that give every cell `biome`.
+    /// Rules that give every cell `biome`, with the shipped vegetation.
     pub fn single_biome(biome: &str) -> BiomeRules {
         let source = format!("fallback = \"{biome}\"\n");
-        BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source)]).expect("single-biome rules")
+        BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source), vegetation()]).expect("single-biome rules")
+    }
+
+    /// The shipped vegetation file, to load beside test rules.
+    pub fn vegetation() -> (PathBuf, String) {
+        (PathBuf::from("vegetation.toml"), crate::config::shipped::VEGETATION.to_string())
     }
 
     /// Columns over `rect` with elevation (m) and temperature (°C) given per column.

@@ -1,0 +1,394 @@
+//! What grows in each biome, as the owner writes it beside the rules: a
+//! `[vegetation."minecraft:forest"]` table says how wooded the biome is, which tree species
+//! grow there in what proportion, and the chance of each ground plant per column.
+//!
+//! This module owns the vocabulary (species and plant names, checked at load with "did you
+//! mean") and the validated tables; the shapes and blocks they stand for live with chunk
+//! generation (`chunkgen::trees`, `chunkgen::plants`).
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::Path;
+
+use toml::{Spanned, Value};
+
+use super::error::{BiomeError, Location, Problem};
+use super::names::{overworld_biome, suggest_biome, suggest_key, OVERWORLD_BIOMES};
+
+/// A tree species: each has its own vanilla-like shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Species {
+    /// A round crown on a short trunk.
+    Oak,
+    /// A tall oak with branches and several leaf clusters.
+    FancyOak,
+    /// A slim white trunk under a round crown.
+    Birch,
+    /// The old-growth birch: a much taller trunk.
+    TallBirch,
+    /// A narrow cone of spruce.
+    Spruce,
+    /// A tall bare spruce trunk with a small crown at the top (old-growth pine taiga).
+    Pine,
+    /// A giant spruce on a 2×2 trunk.
+    MegaSpruce,
+    /// A jungle tree with vines and cocoa.
+    Jungle,
+    /// A giant jungle tree on a 2×2 trunk, with vines, cocoa and branch clusters.
+    MegaJungle,
+    /// A one-log jungle bush under a mound of leaves.
+    JungleBush,
+    /// A trunk whose top bends off diagonally, under a flat canopy.
+    Acacia,
+    /// A 2×2 trunk under a broad, low crown.
+    DarkOak,
+    /// A trunk raised on arching prop roots.
+    Mangrove,
+    /// A trunk that forks into two branches under a wide pink canopy.
+    Cherry,
+    /// An oak-log trunk under azalea and flowering azalea leaves.
+    Azalea,
+    /// An oak with vines hanging from its crown (swamps).
+    SwampOak,
+}
+
+impl Species {
+    /// Every species, in the order their names are listed.
+    pub const ALL: [Species; 16] = [
+        Species::Oak,
+        Species::FancyOak,
+        Species::Birch,
+        Species::TallBirch,
+        Species::Spruce,
+        Species::Pine,
+        Species::MegaSpruce,
+        Species::Jungle,
+        Species::MegaJungle,
+        Species::JungleBush,
+        Species::Acacia,
+        Species::DarkOak,
+        Species::Mangrove,
+        Species::Cherry,
+        Species::Azalea,
+        Species::SwampOak,
+    ];
+
+    /// How a vegetation table names it.
+    pub fn key(self) -> &'static str {
+        match self {
+            Species::Oak => "oak",
+            Species::FancyOak => "fancy_oak",
+            Species::Birch => "birch",
+            Species::TallBirch => "tall_birch",
+            Species::Spruce => "spruce",
+            Species::Pine => "pine",
+            Species::MegaSpruce => "mega_spruce",
+            Species::Jungle => "jungle",
+            Species::MegaJungle => "mega_jungle",
+            Species::JungleBush => "jungle_bush",
+            Species::Acacia => "acacia",
+            Species::DarkOak => "dark_oak",
+            Species::Mangrove => "mangrove",
+            Species::Cherry => "cherry",
+            Species::Azalea => "azalea",
+            Species::SwampOak => "swamp_oak",
+        }
+    }
+
+    fn from_key(key: &str) -> Option<Species> {
+        Species::ALL.into_iter().find(|s| s.key() == key)
+    }
+}
+
+/// Every ground plant a vegetation table may name: Minecraft 1.20.1 block ids without the
+/// namespace (a two-block flower names its block once; bamboo names the whole stalk).
+pub const PLANTS: &[&str] = &[
+    "grass",
+    "tall_grass",
+    "fern",
+    "large_fern",
+    "dandelion",
+    "poppy",
+    "blue_orchid",
+    "allium",
+    "azure_bluet",
+    "red_tulip",
+    "orange_tulip",
+    "white_tulip",
+    "pink_tulip",
+    "oxeye_daisy",
+    "cornflower",
+    "lily_of_the_valley",
+    "sunflower",
+    "lilac",
+    "rose_bush",
+    "peony",
+    "pink_petals",
+    "dead_bush",
+    "cactus",
+    "sweet_berry_bush",
+    "brown_mushroom",
+    "red_mushroom",
+    "bamboo",
+    "azalea",
+    "flowering_azalea",
+];
+
+/// Every key a vegetation table understands.
+const KEYS: &[&str] = &["trees", "species", "plants"];
+
+/// What grows in one biome.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Vegetation {
+    /// Chance that a 5×5 tree cell of the biome holds a tree, in `[0, 1]`.
+    pub trees: f32,
+    /// The species with their cumulative shares, the last exactly 1.
+    species: Vec<(Species, f32)>,
+    /// Ground plants (names from [`PLANTS`]) with their chance per column; the chances sum
+    /// to at most 1, and each column draws one number against them in this order.
+    pub plants: Vec<(&'static str, f32)>,
+}
+
+impl Vegetation {
+    /// The species for a draw in `[0, 1)`: each gets the share of draws its weight says.
+    pub fn species(&self, draw: f32) -> Option<Species> {
+        self.species.iter().find(|&&(_, upto)| draw < upto).or(self.species.last()).map(|&(s, _)| s)
+    }
+
+    /// The species this biome can grow.
+    pub fn all_species(&self) -> impl Iterator<Item = Species> + '_ {
+        self.species.iter().map(|&(s, _)| s)
+    }
+}
+
+/// The vegetation of every overworld biome, indexed like [`OVERWORLD_BIOMES`].
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Table {
+    by_biome: Vec<Option<Vegetation>>,
+}
+
+impl Table {
+    /// What grows in `biome`; `None` where no table names it (nothing grows).
+    pub(crate) fn get(&self, biome: &str) -> Option<&Vegetation> {
+        let i = OVERWORLD_BIOMES.binary_search(&biome).ok()?;
+        self.by_biome.get(i)?.as_ref()
+    }
+}
+
+/// One file's `[vegetation."…"]` tables, as TOML gives them (keys keep their places).
+pub(crate) type RawTables = BTreeMap<Spanned<String>, Spanned<BTreeMap<Spanned<String>, Spanned<Value>>>>;
+
+/// Collects the tables of every file (in the order given) into one, checking each.
+#[derive(Default)]
+pub(crate) struct Builder {
+    table: Table,
+    first: Vec<Option<Location>>,
+}
+
+impl Builder {
+    /// Adds one file's tables; a biome given twice (in any files) is an error naming both.
+    pub(crate) fn add(&mut self, file: &Path, text: &str, raw: &RawTables) -> Result<(), BiomeError> {
+        if self.table.by_biome.is_empty() {
+            self.table.by_biome = vec![None; OVERWORLD_BIOMES.len()];
+            self.first = vec![None; OVERWORLD_BIOMES.len()];
+        }
+        let mut tables: Vec<_> = raw.iter().collect();
+        tables.sort_by_key(|(name, _)| name.span().start);
+        for (name, body) in tables {
+            let at = |span: Range<usize>| Location {
+                file: file.to_path_buf(),
+                line: super::load::line_of(text, span.start),
+            };
+            let given = name.get_ref();
+            let fail = |span: Range<usize>, problem: Problem| BiomeError::Vegetation {
+                at: at(span),
+                biome: given.clone(),
+                problem: Box::new(problem),
+            };
+            let Some(biome) = overworld_biome(given) else {
+                let problem = Problem::UnknownBiome { biome: given.clone(), suggestion: suggest_biome(given) };
+                return Err(fail(name.span(), problem));
+            };
+            let i = OVERWORLD_BIOMES.binary_search(&biome).expect("an overworld biome");
+            if let Some(first) = &self.first[i] {
+                return Err(fail(name.span(), Problem::VegetationTwice { first: first.clone() }));
+            }
+            let vegetation = parse(body.get_ref()).map_err(|(span, problem)| fail(span, problem))?;
+            self.first[i] = Some(at(name.span()));
+            self.table.by_biome[i] = Some(vegetation);
+        }
+        Ok(())
+    }
+
+    /// The finished table.
+    pub(crate) fn finish(mut self) -> Table {
+        if self.table.by_biome.is_empty() {
+            self.table.by_biome = vec![None; OVERWORLD_BIOMES.len()];
+        }
+        self.table
+    }
+}
+
+/// One biome's table, key by key.
+fn parse(body: &BTreeMap<Spanned<String>, Spanned<Value>>) -> Result<Vegetation, (Range<usize>, Problem)> {
+    let mut vegetation = Vegetation::default();
+    let mut entries: Vec<_> = body.iter().collect();
+    entries.sort_by_key(|(key, _)| key.span().start);
+    let mut trees_at = None;
+    for (key, value) in entries {
+        let wrong =
+            |expected: &'static str| (value.span(), Problem::WrongType { key: key.get_ref().clone(), expected });
+        match key.get_ref().as_str() {
+            "trees" => {
+                let chance = number(value.get_ref()).ok_or_else(|| wrong("a number from 0 to 1"))?;
+                vegetation.trees = share("trees", chance).map_err(|p| (value.span(), p))?;
+                trees_at = Some(value.span());
+            }
+            "species" => {
+                let Value::Table(table) = value.get_ref() else {
+                    return Err(wrong("a table of species and weights, such as { oak = 4, birch = 1 }"));
+                };
+                let mut weights = Vec::new();
+                for (name, weight) in table {
+                    let species = Species::from_key(name).ok_or_else(|| {
+                        let names: Vec<&'static str> = Species::ALL.iter().map(|s| s.key()).collect();
+                        let suggestion = suggest_key(name, &names);
+                        (value.span(), Problem::UnknownName { what: "species", name: name.clone(), suggestion })
+                    })?;
+                    let weight = number(weight)
+                        .filter(|w| w.is_finite() && *w > 0.0)
+                        .ok_or_else(|| wrong("a table of positive weights, such as { oak = 4, birch = 1 }"))?;
+                    weights.push((species, weight));
+                }
+                let total: f64 = weights.iter().map(|w| w.1).sum();
+                let mut upto = 0.0;
+                vegetation.species = weights
+                    .into_iter()
+                    .map(|(s, w)| {
+                        upto += w / total;
+                        (s, upto as f32)
+                    })
+                    .collect();
+                if let Some(last) = vegetation.species.last_mut() {
+                    last.1 = 1.0;
+                }
+            }
+            "plants" => {
+                let Value::Table(table) = value.get_ref() else {
+                    return Err(wrong("a table of plants and chances per column, such as { grass = 0.2 }"));
+                };
+                let mut total = 0.0;
+                for (name, chance) in table {
+                    let Some(&plant) = PLANTS.iter().find(|&&p| p == name) else {
+                        let suggestion = suggest_key(name, PLANTS);
+                        return Err((
+                            value.span(),
+                            Problem::UnknownName { what: "plant", name: name.clone(), suggestion },
+                        ));
+                    };
+                    let chance = number(chance).ok_or_else(|| wrong("a table of chances from 0 to 1"))?;
+                    let chance = share(plant, chance).map_err(|p| (value.span(), p))?;
+                    total += f64::from(chance);
+                    vegetation.plants.push((plant, chance));
+                }
+                if total > 1.0 + 1e-6 {
+                    return Err((value.span(), Problem::PlantsOverOne { total }));
+                }
+            }
+            other => {
+                let problem = Problem::UnknownKey { key: other.to_string(), suggestion: suggest_key(other, KEYS) };
+                return Err((key.span(), problem));
+            }
+        }
+    }
+    if let (Some(span), true) = (trees_at, vegetation.trees > 0.0 && vegetation.species.is_empty()) {
+        return Err((span, Problem::TreesWithoutSpecies));
+    }
+    Ok(vegetation)
+}
+
+fn number(v: &Value) -> Option<f64> {
+    match v {
+        Value::Integer(i) => Some(*i as f64),
+        Value::Float(f) => Some(*f),
+        _ => None,
+    }
+}
+
+/// A chance, checked to lie in `[0, 1]`.
+fn share(key: &str, chance: f64) -> Result<f32, Problem> {
+    if (0.0..=1.0).contains(&chance) {
+        Ok(chance as f32)
+    } else {
+        Err(Problem::BadChance { key: key.to_string(), value: chance })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::super::BiomeRules;
+    use super::*;
+
+    const RULES: &str = "fallback = \"minecraft:plains\"\n";
+
+    fn load(vegetation: &str) -> Result<BiomeRules, BiomeError> {
+        BiomeRules::from_sources(&[
+            (PathBuf::from("a.toml"), RULES.to_string()),
+            (PathBuf::from("b.toml"), vegetation.to_string()),
+        ])
+    }
+
+    fn error(vegetation: &str) -> String {
+        load(vegetation).expect_err("must be rejected").to_string()
+    }
+
+    #[test]
+    fn a_table_gives_trees_species_by_weight_and_plants() {
+        let rules = load(
+            "[vegetation.\"minecraft:forest\"]\ntrees = 0.5\nspecies = { oak = 3, birch = 1 }\n\
+             plants = { grass = 0.25, poppy = 0.01 }\n",
+        )
+        .expect("loads");
+        let forest = rules.vegetation("minecraft:forest").expect("forest has vegetation");
+        assert_eq!(forest.trees, 0.5);
+        let share = |s: Species| (0..1000).filter(|&i| forest.species(i as f32 / 1000.0) == Some(s)).count();
+        assert_eq!((share(Species::Oak), share(Species::Birch)), (750, 250));
+        assert!(forest.species(0.999_999_9).is_some(), "every draw below 1 has a species");
+        assert_eq!(forest.plants, vec![("grass", 0.25), ("poppy", 0.01)]);
+        assert!(rules.vegetation("minecraft:desert").is_none(), "no table: nothing grows");
+    }
+
+    #[test]
+    fn mistakes_name_the_file_line_biome_and_what_is_wrong() {
+        let e = error("\n[vegetation.\"minecraft:forset\"]\ntrees = 0.5\n");
+        assert!(e.starts_with("b.toml:2: vegetation for \"minecraft:forset\": unknown biome"), "{e}");
+        assert!(e.contains("did you mean \"minecraft:forest\""), "{e}");
+        let e = error("[vegetation.\"minecraft:forest\"]\ntrees = 0.5\nspecies = { oak = 1, burch = 1 }\n");
+        assert!(e.starts_with("b.toml:3: vegetation for \"minecraft:forest\": unknown species \"burch\""), "{e}");
+        assert!(e.contains("did you mean \"birch\""), "{e}");
+        let e = error("[vegetation.\"minecraft:forest\"]\nplants = { grass = 0.5, dandelon = 0.1 }\n");
+        assert!(
+            e.contains("b.toml:2:") && e.contains("unknown plant \"dandelon\" (did you mean \"dandelion\"?)"),
+            "{e}"
+        );
+        let e = error("[vegetation.\"minecraft:forest\"]\nplants = { grass = 0.7, fern = 0.6 }\n");
+        assert!(e.contains("sum to 1.3"), "{e}");
+        let e = error("[vegetation.\"minecraft:forest\"]\n\ntrees = 1.5\n");
+        assert!(e.starts_with("b.toml:3:") && e.contains("`trees` must be from 0 to 1, not 1.5"), "{e}");
+        let e = error("[vegetation.\"minecraft:forest\"]\ntrees = 0.5\n");
+        assert!(e.contains("needs `species`"), "{e}");
+        let e = error("[vegetation.\"minecraft:forest\"]\ntres = 0.5\n");
+        assert!(e.contains("unknown key `tres` (did you mean `trees`?)"), "{e}");
+        let e = error("[vegetation.\"minecraft:forest\"]\nspecies = { oak = 0 }\n");
+        assert!(e.contains("positive weights"), "{e}");
+        // A biome given twice, in two files, names the first.
+        let twice = BiomeRules::from_sources(&[
+            (PathBuf::from("a.toml"), format!("{RULES}[vegetation.\"minecraft:forest\"]\ntrees = 0\n")),
+            (PathBuf::from("b.toml"), "\n[vegetation.\"minecraft:forest\"]\ntrees = 0\n".to_string()),
+        ]);
+        let e = twice.expect_err("twice").to_string();
+        assert!(e.starts_with("b.toml:2:") && e.contains("already given at a.toml:2"), "{e}");
+    }
+}
