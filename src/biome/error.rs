@@ -19,6 +19,11 @@ impl fmt::Display for Location {
     }
 }
 
+/// 1-based line of byte `offset` of `text` (for a [`Location`] from a TOML span).
+pub(crate) fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
+}
+
 /// Rule files that cannot be used. Loading stops at the first one, in file order.
 #[derive(Debug, thiserror::Error)]
 pub enum BiomeError {
@@ -62,13 +67,26 @@ pub enum BiomeError {
         /// What is wrong.
         problem: Box<Problem>,
     },
-    /// Something wrong in one biome's `[vegetation."…"]` table.
-    #[error("{at}: vegetation for \"{biome}\": {problem}")]
-    Vegetation {
+    /// Something wrong in one biome's table beside the rules (`[vegetation."…"]`,
+    /// `[surface."…"]`).
+    #[error("{at}: {kind} for \"{biome}\": {problem}")]
+    Table {
         /// The table's header, or the offending key.
         at: Location,
+        /// Which kind of table (`vegetation`, `surface`).
+        kind: &'static str,
         /// The biome as the header names it.
         biome: String,
+        /// What is wrong.
+        problem: Box<Problem>,
+    },
+    /// Something wrong in one `[[vein]]`.
+    #[error("{at}: vein {vein}: {problem}")]
+    Vein {
+        /// The `[[vein]]` header, or the offending key.
+        at: Location,
+        /// `#N` (its place in its file), with its block when it names one: `#3 (iron_ore)`.
+        vein: String,
         /// What is wrong.
         problem: Box<Problem>,
     },
@@ -91,7 +109,8 @@ impl BiomeError {
             BiomeError::Syntax { at, .. }
             | BiomeError::Rule { at, .. }
             | BiomeError::Fallback { at, .. }
-            | BiomeError::Vegetation { at, .. } => Some(at),
+            | BiomeError::Table { at, .. }
+            | BiomeError::Vein { at, .. } => Some(at),
             BiomeError::Read { .. } | BiomeError::NoFiles { .. } | BiomeError::NoFallback { .. } => None,
         }
     }
@@ -177,16 +196,26 @@ pub enum Problem {
         /// The first setting.
         first: Location,
     },
-    /// A species or plant name a vegetation table does not know.
+    /// A species, plant or block name a table does not know.
     #[error("unknown {what} \"{name}\"{}", did_you_mean(.suggestion, "\""))]
     UnknownName {
-        /// `species` or `plant`.
+        /// `species`, `plant` or `block`.
         what: &'static str,
         /// The name as written.
         name: String,
         /// The closest known name.
         suggestion: Option<&'static str>,
     },
+    /// A block where a whole, solid one is needed (ground, a vein): not air, a liquid or a
+    /// thin or see-through block.
+    #[error("\"{block}\" is not a whole, solid block")]
+    NotSolid {
+        /// The block as written.
+        block: String,
+    },
+    /// A vein given both height shapes.
+    #[error("give `uniform` or `triangle`, not both")]
+    TwoHeights,
     /// A biome's plant chances add up to more than one plant per column.
     #[error("the plant chances sum to {total:.2}, more than 1: a column grows one plant at most")]
     PlantsOverOne {
@@ -204,9 +233,9 @@ pub enum Problem {
     /// Trees are asked for, but no species says which.
     #[error("`trees` above 0 needs `species`, such as species = {{ oak = 1 }}")]
     TreesWithoutSpecies,
-    /// A biome's vegetation given a second time.
+    /// A biome's table of one kind given a second time.
     #[error("already given at {first} (one table per biome, over all files)")]
-    VegetationTwice {
+    TableTwice {
         /// The first table.
         first: Location,
     },

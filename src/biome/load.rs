@@ -9,10 +9,13 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::{Spanned, Value};
 
-use super::error::{BiomeError, Location, Problem};
+use super::error::{line_of, BiomeError, Location, Problem};
 use super::names::{overworld_biome, suggest_biome, suggest_key};
+use super::per_biome;
 use super::rules::{Axis, Bounds, Table};
-use super::vegetation;
+use super::surface::{self, Surface};
+use super::underground::{self, Vein};
+use super::vegetation::{self, Vegetation};
 use super::WaterBody;
 
 /// Shorthand for `surface_m` measured downwards, so ocean rules read like ocean charts.
@@ -47,7 +50,11 @@ struct RawFile {
     #[serde(default)]
     rule: Vec<Spanned<BTreeMap<Spanned<String>, Spanned<Value>>>>,
     #[serde(default)]
-    vegetation: vegetation::RawTables,
+    vegetation: per_biome::RawTables,
+    #[serde(default)]
+    surface: per_biome::RawTables,
+    #[serde(default)]
+    vein: Vec<Spanned<per_biome::Body>>,
 }
 
 /// A rule as loaded: its box and what messages need to point at it.
@@ -68,14 +75,18 @@ pub(crate) struct Rule {
 pub(crate) struct Loaded {
     pub(crate) rules: Vec<Rule>,
     pub(crate) table: Table,
-    pub(crate) vegetation: vegetation::Table,
+    pub(crate) vegetation: per_biome::Table<Vegetation>,
+    pub(crate) surface: per_biome::Table<Surface>,
+    pub(crate) veins: Vec<Vein>,
 }
 
 /// Parses and checks `files` in the order given (the caller sorts by name).
 pub(crate) fn load(files: &[(PathBuf, String)]) -> Result<Loaded, BiomeError> {
     let mut rules = Vec::new();
     let mut fallback: Option<(&'static str, Location)> = None;
-    let mut vegetation = vegetation::Builder::default();
+    let mut vegetation = per_biome::Builder::new("vegetation", vegetation::parse);
+    let mut surfaces = per_biome::Builder::new("surface", surface::parse);
+    let mut veins = Vec::new();
     for (file, text) in files {
         let raw: RawFile = toml::from_str(text).map_err(|e| BiomeError::Syntax {
             at: Location { file: file.clone(), line: e.span().map_or(1, |s| line_of(text, s.start)) },
@@ -99,6 +110,10 @@ pub(crate) fn load(files: &[(PathBuf, String)]) -> Result<Loaded, BiomeError> {
             rules.push(parse_rule(file, text, index, table)?);
         }
         vegetation.add(file, text, &raw.vegetation)?;
+        surfaces.add(file, text, &raw.surface)?;
+        for (index, table) in raw.vein.iter().enumerate() {
+            veins.push(parse_vein(file, text, index, table)?);
+        }
     }
     let Some((fallback, _)) = fallback else {
         return Err(BiomeError::NoFallback { file: files.first().map(|(f, _)| f.clone()).unwrap_or_default() });
@@ -110,7 +125,7 @@ pub(crate) fn load(files: &[(PathBuf, String)]) -> Result<Loaded, BiomeError> {
         biomes: rules.iter().map(|r| r.biome).collect(),
         fallback,
     };
-    Ok(Loaded { rules, table, vegetation: vegetation.finish() })
+    Ok(Loaded { rules, table, vegetation: vegetation.finish(), surface: surfaces.finish(), veins })
 }
 
 /// The parser's message, with a hint for the one mistake it words obscurely: `[rule]`
@@ -124,9 +139,19 @@ fn syntax_message(message: &str) -> String {
     }
 }
 
-/// 1-based line of byte `offset`.
-pub(crate) fn line_of(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
+/// One `[[vein]]`, with its place and block in any message.
+fn parse_vein(file: &Path, text: &str, index: usize, table: &Spanned<per_biome::Body>) -> Result<Vein, BiomeError> {
+    underground::parse(table.get_ref(), table.span()).map_err(|(span, problem)| {
+        let block = table.get_ref().iter().find(|(k, _)| k.get_ref() == "block");
+        let vein = match block.map(|(_, v)| v.get_ref()) {
+            Some(Value::String(name)) if !matches!(problem, Problem::UnknownName { .. }) => {
+                format!("#{} ({name})", index + 1)
+            }
+            _ => format!("#{}", index + 1),
+        };
+        let at = Location { file: file.to_path_buf(), line: line_of(text, span.start) };
+        BiomeError::Vein { at, vein, problem: Box::new(problem) }
+    })
 }
 
 /// One `[[rule]]` table, checked key by key in file order.

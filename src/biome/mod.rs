@@ -7,9 +7,11 @@
 //! the server's reload command (it only offers a load that either fully succeeds or changes
 //! nothing), Minecraft registries beyond names.
 //!
-//! Beside the rules, `[vegetation."minecraft:…"]` tables (shipped in
-//! `biomes/vegetation.toml`, documented at its top) say what grows in each biome: how wooded
-//! it is, which tree species in what shares, and the chance of each ground plant.
+//! Beside the rules, tables keyed by biome say what each biome looks like: `[vegetation."…"]`
+//! (shipped in `biomes/vegetation.toml`) how wooded it is, which tree species in what shares
+//! and the chance of each ground plant; `[surface."…"]` (`biomes/surface.toml`) the blocks of
+//! its ground; and `[[vein]]`s (`biomes/underground.toml`) the ore and rock placements under
+//! every biome. Each file documents its keys at its top.
 //!
 //! Semantics in one paragraph: files are read in file-name order and their rules
 //! concatenated; a rule is a box of half-open ranges `[min, max)`, one per quantity it names;
@@ -21,7 +23,10 @@
 mod error;
 mod load;
 mod names;
+mod per_biome;
 mod rules;
+mod surface;
+mod underground;
 mod vegetation;
 
 #[cfg(test)]
@@ -33,6 +38,8 @@ use std::path::{Path, PathBuf};
 
 pub use error::{BiomeError, Location, Problem};
 pub use names::OVERWORLD_BIOMES;
+pub use surface::Surface;
+pub use underground::{Vein, VeinHeight, MAX_SIZE as MAX_VEIN_SIZE};
 pub use vegetation::{Species, Vegetation, PLANTS};
 
 /// What a rule sees for one 4×4×4 biome cell.
@@ -110,7 +117,11 @@ pub struct BiomeRules {
     /// Names of the rules, parallel to the table (for [`BiomeRules::matching_rule`]).
     names: Vec<String>,
     /// What grows in each biome.
-    vegetation: vegetation::Table,
+    vegetation: per_biome::Table<Vegetation>,
+    /// The ground of each biome's dry land.
+    surface: per_biome::Table<Surface>,
+    /// The veins of ore and rock, in file order.
+    veins: Vec<Vein>,
 }
 
 impl BiomeRules {
@@ -148,6 +159,8 @@ impl BiomeRules {
             table: loaded.table,
             names: loaded.rules.into_iter().map(|r| r.name).collect(),
             vegetation: loaded.vegetation,
+            surface: loaded.surface,
+            veins: loaded.veins,
         })
     }
 
@@ -178,6 +191,17 @@ impl BiomeRules {
     /// `[vegetation."…"]` table names it: nothing grows there.
     pub fn vegetation(&self, biome: &str) -> Option<&Vegetation> {
         self.vegetation.get(biome)
+    }
+
+    /// The ground of `biome`'s dry, gentle land: its `[surface."…"]` table, else
+    /// [`Surface::DEFAULT`] (grass over dirt).
+    pub fn surface(&self, biome: &str) -> Surface {
+        self.surface.get(biome).copied().unwrap_or(Surface::DEFAULT)
+    }
+
+    /// Every `[[vein]]` of ore or rock, in file order (the order keys their random draws).
+    pub fn veins(&self) -> &[Vein] {
+        &self.veins
     }
 
     /// The biome used where no rule matches.

@@ -6,14 +6,11 @@
 //! mean") and the validated tables; the shapes and blocks they stand for live with chunk
 //! generation (`chunkgen::trees`, `chunkgen::plants`).
 
-use std::collections::BTreeMap;
-use std::ops::Range;
-use std::path::Path;
+use toml::Value;
 
-use toml::{Spanned, Value};
-
-use super::error::{BiomeError, Location, Problem};
-use super::names::{overworld_biome, suggest_biome, suggest_key, OVERWORLD_BIOMES};
+use super::error::Problem;
+use super::names::suggest_key;
+use super::per_biome::{in_order, number, Body, Mistake};
 
 /// A tree species: each has its own vanilla-like shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -161,81 +158,11 @@ impl Vegetation {
     }
 }
 
-/// The vegetation of every overworld biome, indexed like [`OVERWORLD_BIOMES`].
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Table {
-    by_biome: Vec<Option<Vegetation>>,
-}
-
-impl Table {
-    /// What grows in `biome`; `None` where no table names it (nothing grows).
-    pub(crate) fn get(&self, biome: &str) -> Option<&Vegetation> {
-        let i = OVERWORLD_BIOMES.binary_search(&biome).ok()?;
-        self.by_biome.get(i)?.as_ref()
-    }
-}
-
-/// One file's `[vegetation."…"]` tables, as TOML gives them (keys keep their places).
-pub(crate) type RawTables = BTreeMap<Spanned<String>, Spanned<BTreeMap<Spanned<String>, Spanned<Value>>>>;
-
-/// Collects the tables of every file (in the order given) into one, checking each.
-#[derive(Default)]
-pub(crate) struct Builder {
-    table: Table,
-    first: Vec<Option<Location>>,
-}
-
-impl Builder {
-    /// Adds one file's tables; a biome given twice (in any files) is an error naming both.
-    pub(crate) fn add(&mut self, file: &Path, text: &str, raw: &RawTables) -> Result<(), BiomeError> {
-        if self.table.by_biome.is_empty() {
-            self.table.by_biome = vec![None; OVERWORLD_BIOMES.len()];
-            self.first = vec![None; OVERWORLD_BIOMES.len()];
-        }
-        let mut tables: Vec<_> = raw.iter().collect();
-        tables.sort_by_key(|(name, _)| name.span().start);
-        for (name, body) in tables {
-            let at = |span: Range<usize>| Location {
-                file: file.to_path_buf(),
-                line: super::load::line_of(text, span.start),
-            };
-            let given = name.get_ref();
-            let fail = |span: Range<usize>, problem: Problem| BiomeError::Vegetation {
-                at: at(span),
-                biome: given.clone(),
-                problem: Box::new(problem),
-            };
-            let Some(biome) = overworld_biome(given) else {
-                let problem = Problem::UnknownBiome { biome: given.clone(), suggestion: suggest_biome(given) };
-                return Err(fail(name.span(), problem));
-            };
-            let i = OVERWORLD_BIOMES.binary_search(&biome).expect("an overworld biome");
-            if let Some(first) = &self.first[i] {
-                return Err(fail(name.span(), Problem::VegetationTwice { first: first.clone() }));
-            }
-            let vegetation = parse(body.get_ref()).map_err(|(span, problem)| fail(span, problem))?;
-            self.first[i] = Some(at(name.span()));
-            self.table.by_biome[i] = Some(vegetation);
-        }
-        Ok(())
-    }
-
-    /// The finished table.
-    pub(crate) fn finish(mut self) -> Table {
-        if self.table.by_biome.is_empty() {
-            self.table.by_biome = vec![None; OVERWORLD_BIOMES.len()];
-        }
-        self.table
-    }
-}
-
 /// One biome's table, key by key.
-fn parse(body: &BTreeMap<Spanned<String>, Spanned<Value>>) -> Result<Vegetation, (Range<usize>, Problem)> {
+pub(crate) fn parse(body: &Body) -> Result<Vegetation, Mistake> {
     let mut vegetation = Vegetation::default();
-    let mut entries: Vec<_> = body.iter().collect();
-    entries.sort_by_key(|(key, _)| key.span().start);
     let mut trees_at = None;
-    for (key, value) in entries {
+    for (key, value) in in_order(body) {
         let wrong =
             |expected: &'static str| (value.span(), Problem::WrongType { key: key.get_ref().clone(), expected });
         match key.get_ref().as_str() {
@@ -307,14 +234,6 @@ fn parse(body: &BTreeMap<Spanned<String>, Spanned<Value>>) -> Result<Vegetation,
     Ok(vegetation)
 }
 
-fn number(v: &Value) -> Option<f64> {
-    match v {
-        Value::Integer(i) => Some(*i as f64),
-        Value::Float(f) => Some(*f),
-        _ => None,
-    }
-}
-
 /// A chance, checked to lie in `[0, 1]`.
 fn share(key: &str, chance: f64) -> Result<f32, Problem> {
     if (0.0..=1.0).contains(&chance) {
@@ -328,7 +247,7 @@ fn share(key: &str, chance: f64) -> Result<f32, Problem> {
 mod tests {
     use std::path::PathBuf;
 
-    use super::super::BiomeRules;
+    use super::super::{BiomeError, BiomeRules};
     use super::*;
 
     const RULES: &str = "fallback = \"minecraft:plains\"\n";

@@ -51,7 +51,7 @@ impl Generator {
                 return None;
             }
             let biome = self.surface_biome(rules, columns, x, z);
-            let ground = self.ground_at(columns, biome, x, z);
+            let ground = self.ground_at(rules, columns, biome, x, z);
             if ground.top.is_liquid() {
                 return None;
             }
@@ -97,7 +97,7 @@ impl Generator {
             }
             let Some(species) = vegetation.species(draw) else { continue };
             let ground_y = columns.surface_y(x, z);
-            let ground = self.ground_at(columns, biome, x, z);
+            let ground = self.ground_at(rules, columns, biome, x, z);
             let dry = !columns.is_wet(x, z) && !ground.top.is_liquid();
             let rooted = !cave_field::may_open(self.seed, columns, x, z);
             if dry && rooted && columns.drop_blocks(x, z) < surface::STEEP_DROP_BLOCKS && trees::holds_tree(ground.top)
@@ -144,7 +144,7 @@ impl Generator {
         let top = if cave_field::opens(self.seed, &columns, x, z) {
             "air"
         } else {
-            self.ground_at(&columns, biome, x, z).top.to_kind().to_str()
+            self.ground_at(rules, &columns, biome, x, z).top.to_kind().to_str()
         };
         SurfaceSample { y, biome: biome.to_string(), top, water_y: columns.water_top_y(x, z) }
     }
@@ -163,7 +163,7 @@ impl Generator {
         for z in rect.y0..rect.y1() {
             for x in rect.x0..rect.x1() {
                 let biome = self.surface_biome(rules, &columns, x, z);
-                let top = self.ground_at(&columns, biome, x, z).top;
+                let top = self.ground_at(rules, &columns, biome, x, z).top;
                 out.push(SurfaceSample {
                     y: columns.surface_y(x, z),
                     biome: biome.to_string(),
@@ -176,10 +176,11 @@ impl Generator {
     }
 
     /// The ground of column (`x`, `z`) in `biome` (top and filler, by water depth, steepness
-    /// and temperature).
-    pub(super) fn ground_at(&self, columns: &Columns, biome: &str, x: i64, z: i64) -> Ground {
+    /// and temperature, and the biome's surface table).
+    pub(super) fn ground_at(&self, rules: &BiomeRules, columns: &Columns, biome: &str, x: i64, z: i64) -> Ground {
         surface::ground(&Site {
             biome,
+            soil: rules.surface(biome),
             water_depth: columns.water_depth(x, z),
             water: columns.water(x, z),
             discharge_m3s: columns.get(channel::DISCHARGE, x, z),

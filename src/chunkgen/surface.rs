@@ -5,6 +5,8 @@
 
 use valence::prelude::BlockState;
 
+use crate::biome::Surface;
+
 use super::columns::Water;
 use super::hash::value_noise;
 
@@ -13,6 +15,8 @@ use super::hash::value_noise;
 pub struct Site<'a> {
     /// Biome of the cell holding the surface block (`"minecraft:desert"`).
     pub biome: &'a str,
+    /// The biome's dry-land ground, from its `[surface."…"]` table.
+    pub soil: Surface,
     /// Blocks of water above the surface block (0 on land, at least 1 under the sea).
     pub water_depth: i32,
     /// The water over the column ([`Water::Dry`] on land).
@@ -101,17 +105,7 @@ pub fn ground(site: &Site) -> Ground {
         let top = if powder { BlockState::POWDER_SNOW } else { BlockState::SNOW_BLOCK };
         return layer(top, if powder { BlockState::POWDER_SNOW } else { BlockState::DIRT }, if powder { 1 } else { 2 });
     }
-    match b {
-        "desert" => layer(BlockState::SAND, BlockState::SANDSTONE, 4),
-        "beach" | "snowy_beach" => layer(BlockState::SAND, BlockState::SAND, 3),
-        "stony_shore" | "stony_peaks" => layer(BlockState::STONE, BlockState::STONE, 0),
-        "old_growth_pine_taiga" | "old_growth_spruce_taiga" => layer(BlockState::PODZOL, BlockState::DIRT, 3),
-        "mangrove_swamp" => layer(BlockState::MUD, BlockState::MUD, 3),
-        "windswept_gravelly_hills" => layer(BlockState::GRAVEL, BlockState::GRAVEL, 2),
-        "mushroom_fields" => layer(BlockState::MYCELIUM, BlockState::DIRT, 3),
-        "savanna_plateau" | "windswept_savanna" => layer(BlockState::GRASS_BLOCK, BlockState::COARSE_DIRT, 3),
-        _ => layer(BlockState::GRASS_BLOCK, BlockState::DIRT, 3),
-    }
+    layer(site.soil.top, site.soil.filler, site.soil.depth)
 }
 
 fn underwater(biome: &str, depth: i32, temperature_c: f32) -> Ground {
@@ -188,9 +182,16 @@ pub fn terracotta_band(y: i32) -> BlockState {
 mod tests {
     use super::*;
 
+    /// The shipped tables, loaded once for all the tests' sites.
+    static RULES: std::sync::LazyLock<crate::biome::BiomeRules> = std::sync::LazyLock::new(|| {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("biomes");
+        crate::biome::BiomeRules::load_dir(&dir).expect("the shipped rules load")
+    });
+
     fn site(biome: &str) -> Site<'_> {
         Site {
             biome,
+            soil: RULES.surface(biome),
             water_depth: 0,
             water: Water::Dry,
             discharge_m3s: 0.0,

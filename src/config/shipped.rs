@@ -1,5 +1,5 @@
 //! What the repository ships, compiled into the binary so an installed `infiniterra` runs
-//! from any directory: the configuration file, the default biome rules and vegetation, and the trained
+//! from any directory: the configuration file, the default biome rules with their surfaces, veins and vegetation, and the trained
 //! models (a few MB). A file on disk always wins over these (the lookup order is in
 //! [`find`](super::find)).
 
@@ -18,15 +18,26 @@ pub const BIOMES: &str = include_str!("../../biomes/default.toml");
 /// `biomes/vegetation.toml` as shipped: what grows in each biome.
 pub const VEGETATION: &str = include_str!("../../biomes/vegetation.toml");
 
+/// `biomes/surface.toml` as shipped: the ground of each biome.
+pub const SURFACE: &str = include_str!("../../biomes/surface.toml");
+
+/// `biomes/underground.toml` as shipped: vanilla's ore and rock placements.
+pub const UNDERGROUND: &str = include_str!("../../biomes/underground.toml");
+
 /// The name the built-in biome files go by in messages (each message adds the file).
 pub const BIOMES_NAME: &str = "built-in biomes/";
 
 /// Every shipped biome file as (name for messages, text), in the order they load.
 pub fn biome_sources() -> Vec<(std::path::PathBuf, String)> {
-    [("default.toml", BIOMES), ("vegetation.toml", VEGETATION)]
-        .into_iter()
-        .map(|(name, text)| (std::path::PathBuf::from(format!("{BIOMES_NAME}{name}")), text.to_string()))
-        .collect()
+    [
+        ("default.toml", BIOMES),
+        ("surface.toml", SURFACE),
+        ("underground.toml", UNDERGROUND),
+        ("vegetation.toml", VEGETATION),
+    ]
+    .into_iter()
+    .map(|(name, text)| (std::path::PathBuf::from(format!("{BIOMES_NAME}{name}")), text.to_string()))
+    .collect()
 }
 
 /// Every file of `models/` the learned stages read: manifests and weights.

@@ -79,8 +79,9 @@ pub(crate) mod testing {
 
     /// The rule set of the generator's tests: sea, cold, dry and steep rules over a fallback.
     pub fn rules() -> BiomeRules {
-        BiomeRules::from_sources(&[(PathBuf::from("test.toml"), RULES.to_string()), vegetation()])
-            .expect("test rules load")
+        let [surface, underground, vegetation] = tables();
+        let test = (PathBuf::from("test.toml"), RULES.to_string());
+        BiomeRules::from_sources(&[test, surface, underground, vegetation]).expect("test rules load")
     }
 
     /// The text of [`rules`].
@@ -105,15 +106,22 @@ biome = "minecraft:windswept_hills"
 slope_deg = [8, 90]
 "#;
 
-    /// Rules that give every cell `biome`, with the shipped vegetation.
+    /// Rules that give every cell `biome`, with the shipped surfaces, veins and vegetation.
     pub fn single_biome(biome: &str) -> BiomeRules {
         let source = format!("fallback = \"{biome}\"\n");
-        BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source), vegetation()]).expect("single-biome rules")
+        let [surface, underground, vegetation] = tables();
+        BiomeRules::from_sources(&[(PathBuf::from("one.toml"), source), surface, underground, vegetation])
+            .expect("single-biome rules")
     }
 
-    /// The shipped vegetation file, to load beside test rules.
-    pub fn vegetation() -> (PathBuf, String) {
-        (PathBuf::from("vegetation.toml"), crate::config::shipped::VEGETATION.to_string())
+    /// The shipped surface, underground and vegetation files, to load beside test rules.
+    pub fn tables() -> [(PathBuf, String); 3] {
+        use crate::config::shipped::{SURFACE, UNDERGROUND, VEGETATION};
+        [
+            (PathBuf::from("surface.toml"), SURFACE.to_string()),
+            (PathBuf::from("underground.toml"), UNDERGROUND.to_string()),
+            (PathBuf::from("vegetation.toml"), VEGETATION.to_string()),
+        ]
     }
 
     /// Columns over `rect` with elevation (m) and temperature (°C) given per column.

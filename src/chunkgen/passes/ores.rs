@@ -1,8 +1,9 @@
 //! The ores pass: veins of ore and blobs of other rock in the stone and deepslate the caves
-//! left, with vanilla 1.20.1's placements (attempts per chunk, vein size, height range and
-//! shape), from its data-driven world generation (`worldgen/placed_feature/ore_*.json`, as
-//! listed on the Minecraft Wiki's "Ore" page): coal, iron, copper, gold, redstone, lapis,
-//! diamond, emerald in the mountains; granite, diorite, andesite, tuff, gravel and dirt blobs.
+//! left, as the rule folder's `[[vein]]`s list them (`biomes/underground.toml` ships vanilla
+//! 1.20.1's placements — attempts per chunk, vein size, height range and shape — from its
+//! data-driven world generation, `worldgen/placed_feature/ore_*.json`, as listed on the
+//! Minecraft Wiki's "Ore" page: coal, iron, copper, gold, redstone, lapis, diamond, emerald in
+//! the mountains; granite, diorite, andesite, tuff, gravel and dirt blobs).
 //!
 //! A vein belongs to the chunk it starts in; chunks draw the veins of their eight neighbours
 //! too and keep the blocks that fall inside themselves, so veins cross chunk borders whole
@@ -11,73 +12,9 @@
 
 use valence::prelude::{BlockState, Chunk, UnloadedChunk};
 
+use crate::biome::{Vein, VeinHeight};
 use crate::chunkgen::hash::hash3;
 use crate::chunkgen::{ChunkContext, CHUNK};
-
-/// How a placement spreads its heights.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Height {
-    /// Uniform between the two Y (inclusive).
-    Uniform(i32, i32),
-    /// Triangular between the two Y, densest in the middle (vanilla's "trapezoid" with no
-    /// plateau); parts outside the world are simply never drawn.
-    Triangle(i32, i32),
-}
-
-/// One of vanilla's ore placements.
-#[derive(Clone, Copy, Debug)]
-pub struct Ore {
-    /// The block in stone.
-    pub stone: BlockState,
-    /// The block in deepslate.
-    pub deepslate: BlockState,
-    /// Attempts per chunk (vanilla's `count`); fractions are a chance of one more.
-    pub per_chunk: f32,
-    /// Blocks a vein tries to place (vanilla's `size`).
-    pub size: u32,
-    /// Where its attempts start.
-    pub height: Height,
-    /// Only under ground at least this many metres high (emerald: mountains).
-    pub min_elevation_m: f32,
-}
-
-const fn ore(stone: BlockState, deepslate: BlockState, per_chunk: f32, size: u32, height: Height) -> Ore {
-    Ore { stone, deepslate, per_chunk, size, height, min_elevation_m: f32::NEG_INFINITY }
-}
-
-const fn rock(block: BlockState, per_chunk: f32, size: u32, height: Height) -> Ore {
-    ore(block, block, per_chunk, size, height)
-}
-
-/// Vanilla 1.20.1's overworld ore and blob placements (Minecraft Wiki, "Ore" and "Blob").
-pub const ORES: [Ore; 22] = {
-    use BlockState as B;
-    use Height::{Triangle as T, Uniform as U};
-    [
-        ore(B::COAL_ORE, B::DEEPSLATE_COAL_ORE, 30.0, 17, U(136, 320)),
-        ore(B::COAL_ORE, B::DEEPSLATE_COAL_ORE, 20.0, 17, T(0, 192)),
-        ore(B::IRON_ORE, B::DEEPSLATE_IRON_ORE, 90.0, 9, T(80, 384)),
-        ore(B::IRON_ORE, B::DEEPSLATE_IRON_ORE, 10.0, 9, T(-24, 56)),
-        ore(B::IRON_ORE, B::DEEPSLATE_IRON_ORE, 10.0, 4, U(-64, 72)),
-        ore(B::COPPER_ORE, B::DEEPSLATE_COPPER_ORE, 16.0, 10, T(-16, 112)),
-        ore(B::GOLD_ORE, B::DEEPSLATE_GOLD_ORE, 4.0, 9, T(-64, 32)),
-        ore(B::GOLD_ORE, B::DEEPSLATE_GOLD_ORE, 0.5, 9, U(-64, -48)),
-        ore(B::REDSTONE_ORE, B::DEEPSLATE_REDSTONE_ORE, 4.0, 8, U(-64, 15)),
-        ore(B::REDSTONE_ORE, B::DEEPSLATE_REDSTONE_ORE, 8.0, 8, T(-96, -32)),
-        ore(B::LAPIS_ORE, B::DEEPSLATE_LAPIS_ORE, 2.0, 7, T(-32, 32)),
-        ore(B::LAPIS_ORE, B::DEEPSLATE_LAPIS_ORE, 4.0, 7, U(-64, 64)),
-        ore(B::DIAMOND_ORE, B::DEEPSLATE_DIAMOND_ORE, 7.0, 4, T(-144, 16)),
-        ore(B::DIAMOND_ORE, B::DEEPSLATE_DIAMOND_ORE, 1.0 / 9.0, 12, T(-144, 16)),
-        Ore { min_elevation_m: 1000.0, ..ore(B::EMERALD_ORE, B::DEEPSLATE_EMERALD_ORE, 100.0, 3, T(-16, 480)) },
-        rock(B::GRANITE, 2.0, 64, U(0, 60)),
-        rock(B::DIORITE, 2.0, 64, U(0, 60)),
-        rock(B::ANDESITE, 2.0, 64, U(0, 60)),
-        rock(B::TUFF, 2.0, 64, U(-64, 0)),
-        rock(B::GRAVEL, 14.0, 33, U(-64, 320)),
-        rock(B::DIRT, 7.0, 33, U(0, 160)),
-        rock(B::GRANITE, 1.0 / 6.0, 64, U(64, 128)),
-    ]
-};
 
 /// Blocks a vanilla vein of each `size` places in solid stone, on average: a Monte Carlo of
 /// vanilla's `OreFeature` (`scripts/vanilla-ore-veins`, 20,000 veins a size). A vein's
@@ -116,13 +53,31 @@ fn expected_blocks(r2: f32) -> f32 {
     n
 }
 
-/// Squared radius (blocks²) of the ball a vein of vanilla `size` fills: the one that places
-/// vanilla's mean number of blocks ([`VANILLA_BLOCKS`]), by bisection, computed once.
+/// Blocks a vein of any `size` from 1 to 64 places on average: vanilla's measured means
+/// ([`VANILLA_BLOCKS`]), interpolated between the sizes measured (log-log, as the means grow
+/// like a power of the size) and in proportion below the smallest.
+fn mean_blocks(size: u32) -> f32 {
+    let size = size.clamp(1, crate::biome::MAX_VEIN_SIZE);
+    if let Some(&(_, measured)) = VANILLA_BLOCKS.iter().find(|&&(s, _)| s == size) {
+        return measured;
+    }
+    let (first, _) = VANILLA_BLOCKS[0];
+    if size <= first {
+        return VANILLA_BLOCKS[0].1 * size as f32 / first as f32;
+    }
+    let i = VANILLA_BLOCKS.iter().position(|&(s, _)| s >= size).unwrap_or(VANILLA_BLOCKS.len() - 1);
+    let ((s0, m0), (s1, m1)) = (VANILLA_BLOCKS[i - 1], VANILLA_BLOCKS[i]);
+    let t = ((size as f32).ln() - (s0 as f32).ln()) / ((s1 as f32).ln() - (s0 as f32).ln());
+    (m0.ln() + t * (m1.ln() - m0.ln())).exp()
+}
+
+/// Squared radius (blocks²) of the ball a vein of `size` fills: the one that places
+/// [`mean_blocks`], by bisection, computed once for every size.
 fn radius2(size: u32) -> f32 {
-    static RADII: std::sync::LazyLock<Vec<(u32, f32)>> = std::sync::LazyLock::new(|| {
-        VANILLA_BLOCKS
-            .iter()
-            .map(|&(size, want)| {
+    static RADII: std::sync::LazyLock<Vec<f32>> = std::sync::LazyLock::new(|| {
+        (0..=crate::biome::MAX_VEIN_SIZE)
+            .map(|size| {
+                let want = mean_blocks(size);
                 let (mut lo, mut hi) = (-JITTER, 400.0f32);
                 for _ in 0..40 {
                     let mid = 0.5 * (lo + hi);
@@ -132,11 +87,11 @@ fn radius2(size: u32) -> f32 {
                         hi = mid;
                     }
                 }
-                (size, 0.5 * (lo + hi))
+                0.5 * (lo + hi)
             })
             .collect()
     });
-    RADII.iter().find(|&&(s, _)| s == size).map_or_else(|| panic!("no vanilla vein of size {size}"), |&(_, r2)| r2)
+    RADII[size.min(crate::biome::MAX_VEIN_SIZE) as usize]
 }
 
 /// Whether the block at offset `d` from a vein's start is in the vein of squared radius `r2`
@@ -159,7 +114,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     let v = *ctx.vertical();
     let (seed, columns) = (ctx.seed(), ctx.columns());
     let (cx, cz) = (ctx.x0.div_euclid(CHUNK), ctx.z0.div_euclid(CHUNK));
-    for (k, ore) in ORES.iter().enumerate() {
+    for (k, ore) in ctx.rules.veins().iter().enumerate() {
         let r = reach(ore.size);
         for nz in cz - 1..=cz + 1 {
             for nx in cx - 1..=cx + 1 {
@@ -191,7 +146,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
 }
 
 /// Where the veins of `ore` that start in chunk (`cx`, `cz`) start (global block coordinates).
-pub fn starts(seed: u64, kind: u64, (cx, cz): (i64, i64), ore: &Ore) -> Vec<(i64, i32, i64)> {
+pub fn starts(seed: u64, kind: u64, (cx, cz): (i64, i64), ore: &Vein) -> Vec<(i64, i32, i64)> {
     let h = |i: u64, what: u64| hash3(seed, 0x0DE5 ^ (kind << 16) ^ (what << 8), cx, i as i64, cz);
     let unit = |x: u64| (x >> 40) as f32 / (1u64 << 24) as f32;
     let whole = ore.per_chunk.floor() as u64;
@@ -202,8 +157,8 @@ pub fn starts(seed: u64, kind: u64, (cx, cz): (i64, i64), ore: &Ore) -> Vec<(i64
             let x = cx * CHUNK + (r & 15) as i64;
             let z = cz * CHUNK + ((r >> 4) & 15) as i64;
             let y = match ore.height {
-                Height::Uniform(lo, hi) => lo + ((r >> 8) % (hi - lo + 1) as u64) as i32,
-                Height::Triangle(lo, hi) => {
+                VeinHeight::Uniform(lo, hi) => lo + ((r >> 8) % (hi - lo + 1) as u64) as i32,
+                VeinHeight::Triangle(lo, hi) => {
                     // The sum of two uniforms is triangular.
                     let half = (hi - lo) as u64 / 2 + 1;
                     lo + ((r >> 8) % half) as i32 + ((r >> 24) % half) as i32
@@ -222,7 +177,7 @@ fn place_vein(
     x0: i64,
     z0: i64,
     min_y: i32,
-    ore: &Ore,
+    ore: &Vein,
     salt: u64,
     (sx, sy, sz): (i64, i32, i64),
 ) {
@@ -247,7 +202,7 @@ fn place_vein(
                 }
                 let (lx, ly, lz) = (lx as u32, ly as u32, lz as u32);
                 let block = match chunk.block_state(lx, ly, lz) {
-                    BlockState::STONE => ore.stone,
+                    BlockState::STONE => ore.block,
                     BlockState::DEEPSLATE => ore.deepslate,
                     _ => continue,
                 };
@@ -297,10 +252,22 @@ mod tests {
     }
 
     #[test]
+    fn sizes_between_vanillas_place_blocks_between_theirs() {
+        for &(size, want) in &VANILLA_BLOCKS {
+            assert!((mean_blocks(size) - want).abs() < 1e-3 * want, "size {size}");
+        }
+        let means: Vec<f32> = (1..=64).map(mean_blocks).collect();
+        assert!(means.windows(2).all(|w| w[0] < w[1]), "{means:?}");
+        assert!(radius2(20) > radius2(17) && radius2(20) < radius2(33));
+    }
+
+    #[test]
     fn veins_start_where_vanilla_places_them() {
-        for (k, ore) in ORES.iter().enumerate() {
+        let rules = testing::single_biome("minecraft:plains");
+        assert_eq!(rules.veins().len(), 22, "vanilla's 22 placements");
+        for (k, ore) in rules.veins().iter().enumerate() {
             let (lo, hi) = match ore.height {
-                Height::Uniform(lo, hi) | Height::Triangle(lo, hi) => (lo, hi),
+                VeinHeight::Uniform(lo, hi) | VeinHeight::Triangle(lo, hi) => (lo, hi),
             };
             let mut n = 0;
             for c in 0..200 {

@@ -20,7 +20,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
         let surface_y = columns.surface_y(x, z);
         let cell_y = ((cells::cell_centre_y(surface_y) - v.min_y) / CELL as i32) as usize;
         let cell = ((lz as i64 / CELL) * 4 + lx as i64 / CELL) as usize;
-        let ground = ctx.generator.ground_at(columns, ctx.biomes[cell * cells_y + cell_y], x, z);
+        let ground = ctx.generator.ground_at(ctx.rules, columns, ctx.biomes[cell * cells_y + cell_y], x, z);
         let mouth = cave_field::may_open(ctx.seed(), columns, x, z);
         // The rock pass filled whole sections only this far below the lowest ground.
         debug_assert!(ground.filler_depth < MAX_GROUND_DEPTH);
