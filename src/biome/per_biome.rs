@@ -105,3 +105,14 @@ pub(crate) fn number(v: &Value) -> Option<f64> {
         _ => None,
     }
 }
+
+/// Rules of a fallback alone (`a.toml`) with `text` as a second file (`b.toml`), as the
+/// tables' tests load them; errors as their messages.
+#[cfg(test)]
+pub(crate) fn load_beside_a_fallback(text: &str) -> Result<super::BiomeRules, String> {
+    super::BiomeRules::from_sources(&[
+        (std::path::PathBuf::from("a.toml"), "fallback = \"minecraft:plains\"\n".to_string()),
+        (std::path::PathBuf::from("b.toml"), text.to_string()),
+    ])
+    .map_err(|e| e.to_string())
+}

@@ -71,18 +71,8 @@ pub(crate) fn parse(body: &Body) -> Result<Surface, Mistake> {
 
 #[cfg(test)]
 mod tests {
-    use std::path::PathBuf;
-
-    use super::super::BiomeRules;
+    use super::super::per_biome::load_beside_a_fallback as load;
     use super::*;
-
-    fn load(surface: &str) -> Result<BiomeRules, String> {
-        BiomeRules::from_sources(&[
-            (PathBuf::from("a.toml"), "fallback = \"minecraft:plains\"\n".to_string()),
-            (PathBuf::from("b.toml"), surface.to_string()),
-        ])
-        .map_err(|e| e.to_string())
-    }
 
     #[test]
     fn a_table_sets_the_ground_and_a_biome_without_one_is_grass_over_dirt() {

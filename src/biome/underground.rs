@@ -126,18 +126,8 @@ pub(crate) fn solid_block(name: &str) -> Result<BlockState, Problem> {
 
 #[cfg(test)]
 mod tests {
-    use std::path::PathBuf;
-
-    use super::super::BiomeRules;
+    use super::super::per_biome::load_beside_a_fallback as load;
     use super::*;
-
-    fn load(veins: &str) -> Result<BiomeRules, String> {
-        BiomeRules::from_sources(&[
-            (PathBuf::from("a.toml"), "fallback = \"minecraft:plains\"\n".to_string()),
-            (PathBuf::from("b.toml"), veins.to_string()),
-        ])
-        .map_err(|e| e.to_string())
-    }
 
     #[test]
     fn veins_load_in_order_with_their_deepslate_forms() {

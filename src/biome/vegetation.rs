@@ -247,20 +247,14 @@ fn share(key: &str, chance: f64) -> Result<f32, Problem> {
 mod tests {
     use std::path::PathBuf;
 
-    use super::super::{BiomeError, BiomeRules};
+    use super::super::per_biome::load_beside_a_fallback as load;
+    use super::super::BiomeRules;
     use super::*;
 
     const RULES: &str = "fallback = \"minecraft:plains\"\n";
 
-    fn load(vegetation: &str) -> Result<BiomeRules, BiomeError> {
-        BiomeRules::from_sources(&[
-            (PathBuf::from("a.toml"), RULES.to_string()),
-            (PathBuf::from("b.toml"), vegetation.to_string()),
-        ])
-    }
-
     fn error(vegetation: &str) -> String {
-        load(vegetation).expect_err("must be rejected").to_string()
+        load(vegetation).expect_err("must be rejected")
     }
 
     #[test]
