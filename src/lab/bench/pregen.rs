@@ -103,45 +103,16 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     }
     out.push(Measurement::new("join: all 441 chunks of view 10 at a new place, warm server", "s", join));
 
-    // Where a chunk's time goes, one thread, chunks in pre-generation order.
+    // Where a chunk's time goes, one thread, chunks in pre-generation order: far east
+    // (mostly sea, the same sample as every earlier table), then on land by the spawn, where
+    // trees, plants and rivers are.
     let rig = Rig::new(config, &rules)?;
     let generator = rig.source.generator();
-    let palette = BiomePalette::vanilla();
-    let mut encoder = Encoder::new(generator.vertical().min_y, palette.names().to_vec());
-    let plan = Plan::new(Task { center_x: 7_000_000, center_z: 0, radius: 160, shape: Shape::Square }, Shard::ALL);
-    let (mut fill, mut light, mut encode, mut compress) = (0.0, 0.0, 0.0, 0.0);
-    let mut passes: Vec<(&'static str, f64)> = Vec::new();
-    for n in 0..plan.total() {
-        let (x, z) = plan.chunk(n);
-        let t = Instant::now();
-        let (chunk, timings) = generator.chunk_timed(&rules, &palette, x, z);
-        fill += t.elapsed().as_secs_f64();
-        for (i, timing) in timings.iter().enumerate() {
-            if passes.len() <= i {
-                passes.push((timing.name, 0.0));
-            }
-            passes[i].1 += timing.nanos as f64 * 1e-9;
-        }
-        let t = Instant::now();
-        // Reading the blocks counts with light, as the first to need them.
-        let states = States::of(&chunk);
-        let sky = Light::of_states(&states);
-        light += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let nbt = encoder.encode_states(x, z, &chunk, &states, &sky);
-        encode += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        std::hint::black_box(region::compress(&nbt));
-        compress += t.elapsed().as_secs_f64();
-    }
-    let per = |s: f64| vec![1e3 * s / plan.total() as f64];
-    out.push(Measurement::new("per chunk, 1 thread: terrain + blocks + biomes (fill)", "ms", per(fill)));
-    for (name, seconds) in passes {
-        out.push(Measurement::new(&format!("  of which the {name} pass"), "ms", per(seconds)));
-    }
-    out.push(Measurement::new("per chunk, 1 thread: light (sky and block)", "ms", per(light)));
-    out.push(Measurement::new("per chunk, 1 thread: NBT encoding", "ms", per(encode)));
-    out.push(Measurement::new("per chunk, 1 thread: zlib compression", "ms", per(compress)));
+    let sea = Task { center_x: 7_000_000, center_z: 0, radius: 160, shape: Shape::Square };
+    out.extend(per_chunk(generator, &rules, sea, "per chunk, 1 thread", true));
+    let spawn = crate::world::find_spawn(generator, &rules).block;
+    let land = Task { center_x: i64::from(spawn.x), center_z: i64::from(spawn.z), radius: 160, shape: Shape::Square };
+    out.extend(per_chunk(generator, &rules, land, "per chunk on land by the spawn, 1 thread", false));
 
     if chunks > 0 {
         // Throughput and memory of a long run: a square of about `chunks` chunks.
@@ -159,6 +130,53 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
         out.push(Measurement::new("pregen: peak resident memory during that run", "MiB", vec![peak]));
     }
     Ok(out)
+}
+
+/// Where the time of each chunk of `task` goes, one thread, in pre-generation order: the fill
+/// and each pass, and with `all`, light, NBT and zlib too. Lines start with `label`.
+fn per_chunk(generator: &Generator, rules: &BiomeRules, task: Task, label: &str, all: bool) -> Vec<Measurement> {
+    let palette = BiomePalette::vanilla();
+    let mut encoder = Encoder::new(generator.vertical().min_y, palette.names().to_vec());
+    let plan = Plan::new(task, Shard::ALL);
+    let (mut fill, mut light, mut encode, mut compress) = (0.0, 0.0, 0.0, 0.0);
+    let mut passes: Vec<(&'static str, f64)> = Vec::new();
+    for n in 0..plan.total() {
+        let (x, z) = plan.chunk(n);
+        let t = Instant::now();
+        let (chunk, timings) = generator.chunk_timed(rules, &palette, x, z);
+        fill += t.elapsed().as_secs_f64();
+        for (i, timing) in timings.iter().enumerate() {
+            if passes.len() <= i {
+                passes.push((timing.name, 0.0));
+            }
+            passes[i].1 += timing.nanos as f64 * 1e-9;
+        }
+        if !all {
+            continue;
+        }
+        let t = Instant::now();
+        // Reading the blocks counts with light, as the first to need them.
+        let states = States::of(&chunk);
+        let sky = Light::of_states(&states);
+        light += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let nbt = encoder.encode_states(x, z, &chunk, &states, &sky);
+        encode += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        std::hint::black_box(region::compress(&nbt));
+        compress += t.elapsed().as_secs_f64();
+    }
+    let per = |s: f64| vec![1e3 * s / plan.total() as f64];
+    let mut out = vec![Measurement::new(&format!("{label}: terrain + blocks + biomes (fill)"), "ms", per(fill))];
+    for (name, seconds) in passes {
+        out.push(Measurement::new(&format!("  of which the {name} pass"), "ms", per(seconds)));
+    }
+    if all {
+        out.push(Measurement::new(&format!("{label}: light (sky and block)"), "ms", per(light)));
+        out.push(Measurement::new(&format!("{label}: NBT encoding"), "ms", per(encode)));
+        out.push(Measurement::new(&format!("{label}: zlib compression"), "ms", per(compress)));
+    }
+    out
 }
 
 /// Resets the kernel's peak-RSS counter (Linux: `echo 5 > /proc/self/clear_refs`), so the
