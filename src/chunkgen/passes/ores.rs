@@ -114,6 +114,10 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
     let v = *ctx.vertical();
     let (seed, columns) = (ctx.seed(), ctx.columns());
     let (cx, cz) = (ctx.x0.div_euclid(CHUNK), ctx.z0.div_euclid(CHUNK));
+    // No stone lies above the chunk's highest ground (the terrain is a height field), so a
+    // vein that starts more than its reach above it places nothing: most of the upper iron,
+    // coal and emerald attempts.
+    let highest = ctx.each_column().map(|(_, _, x, z)| columns.surface_y(x, z)).max().unwrap_or(i32::MAX);
     for (k, ore) in ctx.rules.veins().iter().enumerate() {
         let r = reach(ore.size);
         for nz in cz - 1..=cz + 1 {
@@ -124,7 +128,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                     if lx < -r || lx >= CHUNK + r || lz < -r || lz >= CHUNK + r {
                         continue;
                     }
-                    if y < v.min_y + 1 || y >= v.min_y + v.height {
+                    if y < v.min_y + 1 || y >= v.min_y + v.height || i64::from(y) - r > i64::from(highest) {
                         continue;
                     }
                     if ore.min_elevation_m > f32::NEG_INFINITY && columns.elevation(x, z) < ore.min_elevation_m {
