@@ -40,7 +40,7 @@ pub use error::{BiomeError, Location, Problem};
 pub use names::OVERWORLD_BIOMES;
 pub use surface::Surface;
 pub use underground::{Vein, VeinHeight, MAX_SIZE as MAX_VEIN_SIZE};
-pub use vegetation::{Species, Vegetation, PLANTS};
+pub use vegetation::{Species, Vegetation, PLANTS, WATER_PLANTS};
 
 /// What a rule sees for one 4×4×4 biome cell.
 #[derive(Clone, Copy, Debug, PartialEq)]

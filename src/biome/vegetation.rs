@@ -132,7 +132,25 @@ pub const PLANTS: &[&str] = &[
 ];
 
 /// Every key a vegetation table understands.
-const KEYS: &[&str] = &["trees", "species", "plants"];
+const KEYS: &[&str] = &["trees", "species", "plants", "water_plants"];
+
+/// Every plant of the water a vegetation table may name, with where it grows (chunk
+/// generation's aquatic pass decides the exact sites).
+pub const WATER_PLANTS: &[&str] = &[
+    // Sea floors 2–12 blocks deep.
+    "seagrass",
+    // Sea floors at least 5 blocks deep.
+    "kelp",
+    // Reefs in patches of sea floor 3–16 blocks deep: the chance a reef column bears a
+    // coral or a coral fan (the reef blocks stand wherever the biome has coral).
+    "coral",
+    // The surface of lakes and slow rivers.
+    "lily_pad",
+    // Banks: ground beside water at its own height.
+    "sugar_cane",
+    // Water up to 3 blocks deep: a clump from the bed to above the surface.
+    "mangrove_roots",
+];
 
 /// What grows in one biome.
 #[derive(Clone, Debug, PartialEq, Default)]
@@ -144,12 +162,20 @@ pub struct Vegetation {
     /// Ground plants (names from [`PLANTS`]) with their chance per column; the chances sum
     /// to at most 1, and each column draws one number against them in this order.
     pub plants: Vec<(&'static str, f32)>,
+    /// Plants of the water (names from [`WATER_PLANTS`]) with their chance per column where
+    /// they can grow.
+    pub water_plants: Vec<(&'static str, f32)>,
 }
 
 impl Vegetation {
     /// The species for a draw in `[0, 1)`: each gets the share of draws its weight says.
     pub fn species(&self, draw: f32) -> Option<Species> {
         self.species.iter().find(|&&(_, upto)| draw < upto).or(self.species.last()).map(|&(s, _)| s)
+    }
+
+    /// The chance per column of the water plant `name` (0 where the table has none).
+    pub fn water_plant(&self, name: &str) -> f32 {
+        self.water_plants.iter().find(|(n, _)| *n == name).map_or(0.0, |&(_, chance)| chance)
     }
 
     /// The species this biome can grow.
@@ -222,6 +248,24 @@ pub(crate) fn parse(body: &Body) -> Result<Vegetation, Mistake> {
                     return Err((value.span(), Problem::PlantsOverOne { total }));
                 }
             }
+            "water_plants" => {
+                let Value::Table(table) = value.get_ref() else {
+                    return Err(wrong("a table of water plants and chances, such as { seagrass = 0.3 }"));
+                };
+                for (name, chance) in table {
+                    let Some(&plant) = WATER_PLANTS.iter().find(|&&p| p == name) else {
+                        let suggestion = suggest_key(name, WATER_PLANTS);
+                        let problem = Problem::UnknownName { what: "water plant", name: name.clone(), suggestion };
+                        return Err((value.span(), problem));
+                    };
+                    let chance = number(chance).ok_or_else(|| wrong("a table of chances from 0 to 1"))?;
+                    vegetation.water_plants.push((plant, share(plant, chance).map_err(|p| (value.span(), p))?));
+                }
+                let floor: f32 = ["seagrass", "kelp"].iter().map(|&n| vegetation.water_plant(n)).sum();
+                if floor > 1.0 + 1e-6 {
+                    return Err((value.span(), Problem::PlantsOverOne { total: f64::from(floor) }));
+                }
+            }
             other => {
                 let problem = Problem::UnknownKey { key: other.to_string(), suggestion: suggest_key(other, KEYS) };
                 return Err((key.span(), problem));
@@ -270,6 +314,7 @@ mod tests {
         assert_eq!((share(Species::Oak), share(Species::Birch)), (750, 250));
         assert!(forest.species(0.999_999_9).is_some(), "every draw below 1 has a species");
         assert_eq!(forest.plants, vec![("grass", 0.25), ("poppy", 0.01)]);
+        assert_eq!(forest.water_plant("sugar_cane"), 0.0, "none unless the table says");
         assert!(rules.vegetation("minecraft:desert").is_none(), "no table: nothing grows");
     }
 
@@ -294,6 +339,10 @@ mod tests {
         assert!(e.contains("needs `species`"), "{e}");
         let e = error("[vegetation.\"minecraft:forest\"]\ntres = 0.5\n");
         assert!(e.contains("unknown key `tres` (did you mean `trees`?)"), "{e}");
+        let e = error("[vegetation.\"minecraft:ocean\"]\nwater_plants = { seagras = 0.3 }\n");
+        assert!(e.contains("unknown water plant \"seagras\" (did you mean \"seagrass\"?)"), "{e}");
+        let e = error("[vegetation.\"minecraft:ocean\"]\nwater_plants = { seagrass = 0.7, kelp = 0.6 }\n");
+        assert!(e.contains("sum to 1.3"), "{e}");
         let e = error("[vegetation.\"minecraft:forest\"]\nspecies = { oak = 0 }\n");
         assert!(e.contains("positive weights"), "{e}");
         // A biome given twice, in two files, names the first.

@@ -1,8 +1,8 @@
 //! The aquatic pass: what grows by and in water, once the ground, the water and the land's
-//! plants are in place: seagrass and kelp on sea floors that are not frozen, coral reefs in
-//! warm seas, lily pads on
-//! lakes and slow rivers in mild climates, sugar cane on the banks where ground meets water,
-//! mangrove roots in the shallow water of mangrove swamps.
+//! plants are in place — seagrass, kelp and coral reefs on sea floors that are not frozen, lily
+//! pads on lakes and slow rivers, sugar cane on the banks where ground meets water, mangrove
+//! roots in shallow water — each with the chance its biome's vegetation table gives
+//! (`water_plants` in `biomes/vegetation.toml`); this pass decides only where each can stand.
 //!
 //! Like every pass, a pure function of global coordinates: each choice hashes (seed, x, z)
 //! and reads only the column and its four neighbours, which the columns pass provides.
@@ -21,17 +21,10 @@ const SALT_HEIGHT: u64 = 0x6865_6967;
 const SALT_REEF: u64 = 0x7265_6566;
 const SALT_CORAL: u64 = 0x636f_7261;
 
-/// Chance of seagrass on a sea floor column 2–12 blocks deep.
-pub const SEAGRASS_CHANCE: f32 = 0.3;
-/// Chance of a kelp stalk on a sea floor column at least [`KELP_MIN_DEPTH`] deep, in seas of
-/// [`SEA_ICE_C`] … [`KELP_MAX_C`] (vanilla grows kelp in every ocean but the warm and frozen).
-pub const KELP_CHANCE: f32 = 0.06;
+/// The sea floor depths seagrass grows at, blocks.
+pub const SEAGRASS_DEPTHS: std::ops::RangeInclusive<i32> = 2..=12;
 /// The shallowest water kelp grows in, blocks.
 pub const KELP_MIN_DEPTH: i32 = 5;
-/// The warmest sea kelp grows in, °C (warm oceans have coral instead).
-pub const KELP_MAX_C: f32 = 24.0;
-/// The coolest sea coral reefs grow in, °C (vanilla's warm ocean).
-pub const CORAL_MIN_C: f32 = KELP_MAX_C;
 /// The deepest water reefs grow in, blocks.
 pub const CORAL_MAX_DEPTH: i32 = 16;
 /// Width of reef patches, blocks, and the share of the warm shallow floor they cover (about).
@@ -52,19 +45,8 @@ pub fn is_sea_growth(block: BlockState) -> bool {
     block == BlockState::SEAGRASS || name.starts_with("kelp") || name.contains("coral")
 }
 
-/// Chance of a lily pad on a lake or slow river column.
-pub const LILY_PAD_CHANCE: f32 = 0.05;
 /// The fastest river lily pads float on, m³/s.
 pub const LILY_PAD_MAX_M3S: f32 = 20.0;
-/// Chance of sugar cane on a bank column (ground beside water at its own height).
-pub const SUGAR_CANE_CHANCE: f32 = 0.2;
-/// The coldest climate sugar cane grows in, °C.
-pub const SUGAR_CANE_MIN_C: f32 = 8.0;
-/// The biome whose shallow water grows mangrove roots.
-pub const MANGROVE_BIOME: &str = "minecraft:mangrove_swamp";
-/// Chance of a clump of mangrove roots on a water column of [`MANGROVE_BIOME`] at most
-/// [`MANGROVE_MAX_DEPTH`] deep.
-pub const MANGROVE_ROOTS_CHANCE: f32 = 0.25;
 /// The deepest water mangrove roots stand in, blocks.
 pub const MANGROVE_MAX_DEPTH: i32 = 3;
 
@@ -80,10 +62,12 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
         let cell = ((lz as i64 / CELL) * 4 + lx as i64 / CELL) as usize;
         let cell_y = ((cells::cell_centre_y(ground) - v.min_y) / CELL as i32) as usize;
         let biome = ctx.biomes[cell * cells_y + cell_y.min(cells_y - 1)];
+        let Some(vegetation) = ctx.rules.vegetation(biome) else { continue };
+        let chance = |name: &str| vegetation.water_plant(name);
         if let Some(water_top) = columns.water_top_y(x, z) {
             let depth = water_top - ground;
             let rooted = chunk.block_state(lx, ly(ground + 1), lz) == BlockState::WATER;
-            if biome == MANGROVE_BIOME && rooted && depth <= MANGROVE_MAX_DEPTH && roll < MANGROVE_ROOTS_CHANCE {
+            if rooted && depth <= MANGROVE_MAX_DEPTH && roll < chance("mangrove_roots") {
                 // Roots from the mud to one block over the water, as a mangrove stands on them.
                 let wet = BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True);
                 for y in ground + 1..=water_top {
@@ -104,7 +88,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                 if !floor || chunk.block_state(lx, ly(ground + 1), lz) != BlockState::WATER {
                     continue;
                 }
-                let reef = temperature >= CORAL_MIN_C
+                let reef = chance("coral") > 0.0
                     && (3..=CORAL_MAX_DEPTH).contains(&depth)
                     && value_noise(seed, SALT_REEF, x, z, REEF_SCALE) > REEF_THRESHOLD;
                 if reef {
@@ -117,19 +101,19 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                     for y in ground + 1..=mound {
                         chunk.set_block_state(lx, ly(y), lz, block);
                     }
-                    if roll < 0.7 && mound < top_y {
+                    if roll < chance("coral") && mound < top_y {
                         let (coral, fan) = (CORALS[(h >> 16) as usize % 5].1, CORALS[(h >> 24) as usize % 5].2);
                         let grows = if (h >> 32) % 3 == 0 { fan } else { coral };
                         chunk.set_block_state(lx, ly(mound + 1), lz, grows);
                     }
-                } else if depth >= KELP_MIN_DEPTH && temperature < KELP_MAX_C && roll < KELP_CHANCE {
+                } else if depth >= KELP_MIN_DEPTH && roll < chance("kelp") {
                     // A stalk that stops at least two blocks under the surface.
                     let tall = 1 + (hash3(seed, SALT_HEIGHT, x, 0, z) % (depth - 2).clamp(1, 12) as u64) as i32;
                     for y in ground + 1..ground + tall {
                         chunk.set_block_state(lx, ly(y), lz, BlockState::KELP_PLANT);
                     }
                     chunk.set_block_state(lx, ly(ground + tall), lz, BlockState::KELP);
-                } else if (2..=12).contains(&depth) && roll < KELP_CHANCE + SEAGRASS_CHANCE {
+                } else if SEAGRASS_DEPTHS.contains(&depth) && roll < chance("kelp") + chance("seagrass") {
                     chunk.set_block_state(lx, ly(ground + 1), lz, BlockState::SEAGRASS);
                 }
             }
@@ -141,7 +125,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                     && [(1, 0), (-1, 0), (0, 1), (0, -1)]
                         .iter()
                         .all(|&(dx, dz)| columns.water_top_y(x + dx, z + dz).is_none_or(|t| t == water_top));
-                if slow && open && temperature >= SUGAR_CANE_MIN_C && roll < LILY_PAD_CHANCE {
+                if slow && open && roll < chance("lily_pad") {
                     chunk.set_block_state(lx, ly(water_top + 1), lz, BlockState::LILY_PAD);
                 }
             }
@@ -158,7 +142,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
                 let bank = [(1, 0), (-1, 0), (0, 1), (0, -1)]
                     .iter()
                     .any(|&(dx, dz)| columns.water_top_y(x + dx, z + dz) == Some(ground));
-                if !(soil && bank && temperature >= SUGAR_CANE_MIN_C && roll < SUGAR_CANE_CHANCE) {
+                if !(soil && bank && roll < chance("sugar_cane")) {
                     continue;
                 }
                 let tall = 1 + (hash3(seed, SALT_HEIGHT, x, 0, z) % 3) as i32;
@@ -269,7 +253,7 @@ mod tests {
 
     #[test]
     fn mangrove_swamps_grow_roots_in_shallow_water_from_the_bed_to_over_the_surface() {
-        let (swamp, v) = grow(|_, _| (-30.0, 26.0), MANGROVE_BIOME);
+        let (swamp, v) = grow(|_, _| (-30.0, 26.0), "minecraft:mangrove_swamp");
         let roots = count(&swamp, &v, BlockState::MANGROVE_ROOTS);
         let wet = count(&swamp, &v, BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True));
         assert!(wet > 20 && roots > 10, "{wet} waterlogged, {roots} over the water");
@@ -284,7 +268,7 @@ mod tests {
             }
         }
         // Deep water and other biomes grow none.
-        let (deep, v) = grow(|_, _| (-1000.0, 26.0), MANGROVE_BIOME);
+        let (deep, v) = grow(|_, _| (-1000.0, 26.0), "minecraft:mangrove_swamp");
         assert_eq!(count(&deep, &v, BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True)), 0);
         let (ocean, v) = grow(|_, _| (-30.0, 26.0), "minecraft:warm_ocean");
         assert_eq!(count(&ocean, &v, BlockState::MANGROVE_ROOTS.set(PropName::Waterlogged, PropValue::True)), 0);
