@@ -172,6 +172,15 @@ mod tests {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("biomes");
         let from_disk = RulesSource::Dir(dir).load().expect("biomes/ loads");
         assert_eq!(from_disk.rule_count(), rules.rule_count());
+        // Every shipped file is built in: the tables beside the rules match the folder's.
+        assert_eq!(from_disk.veins(), rules.veins());
+        assert_eq!(rules.veins().len(), 22);
+        for biome in crate::biome::OVERWORLD_BIOMES {
+            assert_eq!(from_disk.vegetation(biome), rules.vegetation(biome), "{biome}");
+            assert_eq!(from_disk.surface(biome), rules.surface(biome), "{biome}");
+        }
+        assert!(rules.vegetation("minecraft:forest").is_some_and(|v| v.trees > 0.0));
+        assert_ne!(rules.surface("minecraft:desert"), crate::biome::Surface::DEFAULT);
     }
 
     #[test]
