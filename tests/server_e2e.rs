@@ -229,6 +229,12 @@ fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
     server.command("reload");
     let failed = server.expect_line(|l| l.starts_with("reload"), LINE_TIMEOUT);
     assert!(failed.contains("failed") && failed.contains("zz_broken.toml"), "{failed}");
+    // A broken vegetation table is refused the same way, naming its line and biome.
+    std::fs::write(biomes.join("zz_broken.toml"), "\n[vegetation.\"minecraft:stony_peaks\"]\ntrees = 2\n").expect("write");
+    server.command("reload");
+    let failed = server.expect_line(|l| l.starts_with("reload"), LINE_TIMEOUT);
+    let said = "zz_broken.toml:3: vegetation for \"minecraft:stony_peaks\": `trees` must be from 0 to 1, not 2";
+    assert!(failed.contains("failed") && failed.contains(said), "{failed}");
     let report = server.probe("second", &column);
     assert_eq!(report["columns"][0]["biome"], short(&before.biome));
     // Chunks on screen keep the rules they were built with: let them go first.
