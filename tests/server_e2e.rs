@@ -230,7 +230,8 @@ fn reload_keeps_the_old_rules_on_error_and_applies_good_rules_to_new_chunks() {
     let failed = server.expect_line(|l| l.starts_with("reload"), LINE_TIMEOUT);
     assert!(failed.contains("failed") && failed.contains("zz_broken.toml"), "{failed}");
     // A broken vegetation table is refused the same way, naming its line and biome.
-    std::fs::write(biomes.join("zz_broken.toml"), "\n[vegetation.\"minecraft:stony_peaks\"]\ntrees = 2\n").expect("write");
+    std::fs::write(biomes.join("zz_broken.toml"), "\n[vegetation.\"minecraft:stony_peaks\"]\ntrees = 2\n")
+        .expect("write");
     server.command("reload");
     let failed = server.expect_line(|l| l.starts_with("reload"), LINE_TIMEOUT);
     let said = "zz_broken.toml:3: vegetation for \"minecraft:stony_peaks\": `trees` must be from 0 to 1, not 2";
