@@ -1,10 +1,12 @@
 //! What grows in each biome, as the owner writes it beside the rules: a
 //! `[vegetation."minecraft:forest"]` table says how wooded the biome is, which tree species
-//! grow there in what proportion, and the chance of each ground plant per column.
+//! grow there in what proportion, the chance of each ground plant per column and of each
+//! plant of the water.
 //!
 //! This module owns the vocabulary (species and plant names, checked at load with "did you
-//! mean") and the validated tables; the shapes and blocks they stand for live with chunk
-//! generation (`chunkgen::trees`, `chunkgen::plants`).
+//! mean") and the parse of one table (`per_biome` gathers them); the shapes, sites and blocks
+//! they stand for live with chunk generation (`chunkgen::trees`, `chunkgen::plants`, the
+//! aquatic pass).
 
 use toml::Value;
 
