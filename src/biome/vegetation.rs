@@ -49,11 +49,15 @@ pub enum Species {
     Azalea,
     /// An oak with vines hanging from its crown (swamps).
     SwampOak,
+    /// A huge red mushroom: a stem under a domed cap.
+    HugeRedMushroom,
+    /// A huge brown mushroom: a stem under a flat, wide cap.
+    HugeBrownMushroom,
 }
 
 impl Species {
     /// Every species, in the order their names are listed.
-    pub const ALL: [Species; 16] = [
+    pub const ALL: [Species; 18] = [
         Species::Oak,
         Species::FancyOak,
         Species::Birch,
@@ -70,6 +74,8 @@ impl Species {
         Species::Cherry,
         Species::Azalea,
         Species::SwampOak,
+        Species::HugeRedMushroom,
+        Species::HugeBrownMushroom,
     ];
 
     /// How a vegetation table names it.
@@ -91,6 +97,8 @@ impl Species {
             Species::Cherry => "cherry",
             Species::Azalea => "azalea",
             Species::SwampOak => "swamp_oak",
+            Species::HugeRedMushroom => "huge_red_mushroom",
+            Species::HugeBrownMushroom => "huge_brown_mushroom",
         }
     }
 

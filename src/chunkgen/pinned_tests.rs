@@ -122,10 +122,10 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 /// again for acacias that bend and 2×2 dark oaks (trees reach 4 blocks from their trunk), and
 /// again when vegetation became data (`biomes/vegetation.toml`: sixteen species by weight,
 /// every plant by name) and warm seas grew coral, and again when the water's plants
-/// followed the biomes' tables instead of the temperature.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0xa436_4bcb_5444_2301;
+/// followed the biomes' tables instead of the temperature, and for huge mushrooms.
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xc63c_db0d_dc90_81bb;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded as above.
-const PROCEDURAL_HASH: u64 = 0xb208_d58c_23c8_84ab;
+const PROCEDURAL_HASH: u64 = 0xe2bd_efbe_39a6_d8a1;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core.
 #[cfg(feature = "learned")]

@@ -112,8 +112,14 @@ pub fn candidate_roots(seed: u64, x0: i64, z0: i64, size: i64) -> Vec<(i64, i64,
 pub fn holds_tree(top: BlockState) -> bool {
     matches!(
         top,
-        BlockState::GRASS_BLOCK | BlockState::PODZOL | BlockState::DIRT | BlockState::COARSE_DIRT | BlockState::MUD
-    ) || top == BlockState::SNOW_BLOCK
+        BlockState::GRASS_BLOCK
+            | BlockState::PODZOL
+            | BlockState::DIRT
+            | BlockState::COARSE_DIRT
+            | BlockState::MUD
+            | BlockState::MYCELIUM
+            | BlockState::SNOW_BLOCK
+    )
 }
 
 /// True for the species that stand on a 2×2 trunk where the ground allows.
@@ -124,10 +130,14 @@ pub fn is_wide(species: Species) -> bool {
 /// The columns a 2×2 trunk stands on besides its root (offsets).
 pub const WIDE_TRUNK: [(i64, i64); 3] = [(1, 0), (0, 1), (1, 1)];
 
-/// True for the blocks trees are made of (logs, leaves, mangrove roots, vines, cocoa).
+/// True for the blocks trees are made of (logs, leaves, mangrove roots, vines, cocoa, huge
+/// mushrooms' stems and caps).
 pub fn is_tree_part(block: BlockState) -> bool {
     let name = block.to_kind().to_str();
-    name.ends_with("_log") || name.ends_with("_leaves") || matches!(name, "mangrove_roots" | "vine" | "cocoa")
+    name.ends_with("_log")
+        || name.ends_with("_leaves")
+        || name.ends_with("_mushroom_block")
+        || matches!(name, "mangrove_roots" | "vine" | "cocoa" | "mushroom_stem")
 }
 
 impl Tree {
@@ -157,6 +167,7 @@ impl Tree {
             Species::DarkOak => 4 + a % 3,
             Species::Mangrove => 4 + a % 3,
             Species::Cherry => 5 + a % 3,
+            Species::HugeRedMushroom | Species::HugeBrownMushroom => 5 + a % 3,
         };
         let mut tree = Tree { x, z, ground_y, species, wide, height, shape, top: 0 };
         tree.top = tree.parts().iter().map(|p| p.dy).max().unwrap_or(0);
@@ -210,6 +221,8 @@ impl Tree {
             (Species::Acacia, _) => d.acacia(h),
             (Species::Mangrove, _) => d.mangrove(h),
             (Species::Cherry, _) => d.cherry(h),
+            (Species::HugeRedMushroom, _) => d.huge_mushroom(h, BlockState::RED_MUSHROOM_BLOCK, false),
+            (Species::HugeBrownMushroom, _) => d.huge_mushroom(h, BlockState::BROWN_MUSHROOM_BLOCK, true),
         }
         d.parts
     }
@@ -580,6 +593,28 @@ impl Draw {
     }
 }
 
+impl Draw {
+    /// A huge mushroom: a stem of `h` blocks under a cap of `cap` blocks — flat and seven
+    /// wide (brown) or a dome with three-block walls (red), as vanilla's.
+    fn huge_mushroom(&mut self, h: i32, cap: BlockState, flat: bool) {
+        for dy in 1..=h {
+            self.put(0, dy, 0, BlockState::MUSHROOM_STEM, Layer::Wood);
+        }
+        if flat {
+            self.layer(cap, (0, 0), h + 1, 3, false, Corners::Drop);
+            return;
+        }
+        self.layer(cap, (0, 0), h + 1, 1, false, Corners::Keep);
+        for dy in h - 2..=h {
+            for d in -1..=1 {
+                for (dx, dz) in [(d, 2), (d, -2), (2, d), (-2, d)] {
+                    self.put(dx, dy, dz, cap, Layer::Leaves);
+                }
+            }
+        }
+    }
+}
+
 /// The eight directions around a trunk.
 const DIRECTIONS: [(i64, i64); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
 
@@ -765,6 +800,17 @@ mod tests {
         assert!(grown(Species::Cherry, false).all(|t| spread(&t) == 4));
         assert!(grown(Species::Oak, false).all(|t| spread(&t) == 2));
         assert!(grown(Species::Cherry, false).any(|t| t.parts().iter().any(|p| p.layer == Layer::Hanging)));
+        // A brown mushroom's cap is flat and seven wide; a red one's walls hang three blocks
+        // down around its stem.
+        for t in grown(Species::HugeBrownMushroom, false) {
+            let caps: Vec<Part> = t.parts().into_iter().filter(|p| p.layer == Layer::Leaves).collect();
+            assert!(caps.iter().all(|p| p.dy == t.height + 1) && spread(&t) == 3);
+        }
+        for t in grown(Species::HugeRedMushroom, false) {
+            let walls =
+                t.parts().iter().filter(|p| p.layer == Layer::Leaves && p.dx.abs().max(p.dz.abs()) == 2).count();
+            assert_eq!(walls, 36, "twelve a layer, three layers");
+        }
     }
 
     #[test]
@@ -798,7 +844,7 @@ mod tests {
                     }
                 }
             }
-            assert_eq!(split(15, 61, 8).to_kind().to_str().ends_with("_log"), species != Species::Mangrove);
+            assert!(is_tree_part(split(15, 61, 8)), "{species:?}: no trunk over its root");
         }
     }
 
@@ -857,6 +903,9 @@ mod picture {
             "jungle_leaves" => [48, 170, 30],
             "mangrove_leaves" => [100, 160, 50],
             "azalea_leaves" => [90, 125, 40],
+            "mushroom_stem" => [203, 196, 185],
+            "red_mushroom_block" => [200, 46, 45],
+            "brown_mushroom_block" => [149, 111, 81],
             "flowering_azalea_leaves" => [190, 110, 190],
             _ if name.ends_with("_leaves") => [72, 140, 40],
             _ => return None,
@@ -867,8 +916,8 @@ mod picture {
     #[test]
     #[ignore = "writes docs/trees.png"]
     fn draw_the_species_side_by_side() {
-        // Two rows of eight, each tree in a slot of its own.
-        let (slot, ground, height, per_row) = (12i64, 2i32, 26u32, 8usize);
+        // Two rows of nine, each tree in a slot of its own.
+        let (slot, ground, height, per_row) = (12i64, 2i32, 26u32, 9usize);
         let species = Species::ALL;
         let rows = species.len().div_ceil(per_row) as u32;
         let width = (per_row as i64 * slot) as u32;

@@ -80,6 +80,13 @@ pub fn drop_of(block: BlockState, tool: Option<ItemKind>, pos: BlockPos) -> Opti
         "sweet_berry_bush" => (item("sweet_berries")?, between(2, 3)),
         // Vines need shears (not in play yet).
         "vine" => return None,
+        // A huge mushroom's cap gives a mushroom now and then (vanilla: 0–2, mostly none);
+        // its stem gives nothing without silk touch.
+        "brown_mushroom_block" | "red_mushroom_block" => {
+            let small = name.trim_end_matches("_block");
+            (item(small)?, between(0, 8).saturating_sub(6))
+        }
+        "mushroom_stem" => return None,
         // Grass gives seeds one time in eight.
         "grass" | "tall_grass" | "fern" | "large_fern" if draw < 0.125 => (item("wheat_seeds")?, 1),
         "grass" | "tall_grass" | "fern" | "large_fern" | "ice" | "packed_ice" | "blue_ice" | "glass" | "glass_pane"
@@ -319,6 +326,10 @@ mod tests {
         assert_eq!(beans, Some(ItemKind::CocoaBeans));
         assert_eq!(drop_of(BlockState::SWEET_BERRY_BUSH, None, at(1)).map(|d| d.0), Some(ItemKind::SweetBerries));
         assert_eq!(drop_of(BlockState::VINE, None, at(1)), None);
+        assert_eq!(drop_of(BlockState::MUSHROOM_STEM, None, at(1)), None);
+        let caps: Vec<_> = (0..400).filter_map(|x| drop_of(BlockState::RED_MUSHROOM_BLOCK, None, at(x))).collect();
+        assert!(caps.iter().all(|&(item, n)| item == ItemKind::RedMushroom && (1..=2).contains(&n)), "{caps:?}");
+        assert!((20..120).contains(&caps.len()), "{} of 400 caps gave a mushroom", caps.len());
         let sapling = |leaves: BlockState| (0..400).find_map(|x| drop_of(leaves, None, at(x))).map(|d| d.0);
         assert_eq!(sapling(BlockState::MANGROVE_LEAVES), Some(ItemKind::MangrovePropagule));
         assert_eq!(sapling(BlockState::FLOWERING_AZALEA_LEAVES), Some(ItemKind::FloweringAzalea));

@@ -103,7 +103,7 @@ def main(argv):
     names = sorted(codes, key=codes.get)
     is_in = lambda group: np.isin(area, [codes[n] for n in group if n in codes])  # noqa: E731
     # Trees stand on the ground; they are not it (nor is the air under their crowns).
-    trees = {n for n in codes if n.endswith(("_log", "_leaves")) or n == "mangrove_roots"}
+    trees = {n for n in codes if n.endswith(("_log", "_leaves", "_mushroom_block")) or n in ("mangrove_roots", "mushroom_stem")}
     not_ground = is_in(NOT_GROUND | trees)
     # Ground: the highest block of each column that is neither in NOT_GROUND nor a tree.
     ground = np.full((nz, nx), -1)

@@ -110,8 +110,8 @@ const PLANTS = new Set([
   'brown_mushroom', 'red_mushroom', 'bamboo', 'azalea', 'flowering_azalea', 'sugar_cane', 'lily_pad', 'snow'
 ])
 
-// Blocks of trees besides logs and leaves (src/chunkgen/trees.rs).
-const TREE_PARTS = new Set(['mangrove_roots', 'vine', 'cocoa'])
+// Blocks of trees besides logs and leaves, huge mushrooms' among them (src/chunkgen/trees.rs).
+const TREE_PARTS = new Set(['mangrove_roots', 'vine', 'cocoa', 'mushroom_stem', 'red_mushroom_block', 'brown_mushroom_block'])
 
 // The ground of column (x, z): its highest block that is neither air, a plant nor part of a tree, with
 // its biome and sky light, and whether anything (a tree) stands above it; null when the
