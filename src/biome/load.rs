@@ -11,7 +11,7 @@ use toml::{Spanned, Value};
 
 use super::error::{line_of, BiomeError, Location, Problem};
 use super::names::{overworld_biome, suggest_biome, suggest_key};
-use super::per_biome;
+use super::per_biome::{self, number};
 use super::rules::{Axis, Bounds, Table};
 use super::surface::{self, Surface};
 use super::underground::{self, Vein};
@@ -256,11 +256,6 @@ fn parse_rule(
 
 /// A `[min, max]` range of `key`, checked against the axis' physical `limits`.
 fn parse_range(key: &'static str, value: &Value, limits: (f32, f32)) -> Result<(f32, f32), Problem> {
-    let number = |v: &Value| match v {
-        Value::Integer(i) => Some(*i as f64),
-        Value::Float(f) => Some(*f),
-        _ => None,
-    };
     let wrong = || Problem::WrongType { key: key.to_string(), expected: RANGE_SHAPE };
     let Value::Array(items) = value else { return Err(wrong()) };
     let [lo, hi] = items.as_slice() else { return Err(wrong()) };

@@ -1,12 +1,14 @@
 //! Tables keyed by biome that sit beside the rules (`[vegetation."minecraft:forest"]`,
 //! `[surface."minecraft:desert"]`): reading them from every file in order, one table per
-//! biome over all files, each checked by its own parser with `file:line` errors.
+//! biome over all files, each checked by its own parser with `file:line` errors; and what
+//! those parsers share (numbers, solid blocks).
 
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::Path;
 
 use toml::{Spanned, Value};
+use valence::prelude::{BlockKind, BlockState};
 
 use super::error::{line_of, BiomeError, Location, Problem};
 use super::names::{overworld_biome, suggest_biome, OVERWORLD_BIOMES};
@@ -95,6 +97,20 @@ pub(crate) fn in_order(body: &Body) -> Vec<(&Spanned<String>, &Spanned<Value>)> 
     let mut entries: Vec<_> = body.iter().collect();
     entries.sort_by_key(|(key, _)| key.span().start);
     entries
+}
+
+/// A whole, solid block by its 1.20.1 id (with or without `minecraft:`).
+pub(crate) fn solid_block(name: &str) -> Result<BlockState, Problem> {
+    let bare = name.strip_prefix("minecraft:").unwrap_or(name);
+    let Some(kind) = BlockKind::from_str(bare) else {
+        return Err(Problem::UnknownName { what: "block", name: name.to_string(), suggestion: None });
+    };
+    let block = kind.to_state();
+    // Not air, a liquid or something thin or see-through a player falls into or sees through.
+    if block.is_air() || block.is_liquid() || !block.is_opaque() {
+        return Err(Problem::NotSolid { block: name.to_string() });
+    }
+    Ok(block)
 }
 
 /// A TOML number as `f64`.

@@ -11,8 +11,7 @@ use valence::prelude::BlockState;
 
 use super::error::Problem;
 use super::names::suggest_key;
-use super::per_biome::{in_order, number, Body, Mistake};
-use super::underground::solid_block;
+use super::per_biome::{in_order, number, solid_block, Body, Mistake};
 
 /// The ground of a biome's dry land, top down.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -7,11 +7,11 @@
 use std::ops::Range;
 
 use toml::Value;
-use valence::prelude::{BlockKind, BlockState};
+use valence::prelude::BlockState;
 
 use super::error::Problem;
 use super::names::suggest_key;
-use super::per_biome::{in_order, number, Body, Mistake};
+use super::per_biome::{in_order, number, solid_block, Body, Mistake};
 
 /// How a vein's start heights spread.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,20 +108,6 @@ pub(crate) fn parse(body: &Body, header: Range<usize>) -> Result<Vein, Mistake> 
         height: height.ok_or_else(|| missing("uniform` or `triangle"))?,
         min_elevation_m,
     })
-}
-
-/// A whole, solid block by its 1.20.1 id (with or without `minecraft:`).
-pub(crate) fn solid_block(name: &str) -> Result<BlockState, Problem> {
-    let bare = name.strip_prefix("minecraft:").unwrap_or(name);
-    let Some(kind) = BlockKind::from_str(bare) else {
-        return Err(Problem::UnknownName { what: "block", name: name.to_string(), suggestion: None });
-    };
-    let block = kind.to_state();
-    // Not air, a liquid or something thin or see-through a player falls into or sees through.
-    if block.is_air() || block.is_liquid() || !block.is_opaque() {
-        return Err(Problem::NotSolid { block: name.to_string() });
-    }
-    Ok(block)
 }
 
 #[cfg(test)]

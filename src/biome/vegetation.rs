@@ -237,40 +237,21 @@ pub(crate) fn parse(body: &Body) -> Result<Vegetation, Mistake> {
                 }
             }
             "plants" => {
-                let Value::Table(table) = value.get_ref() else {
-                    return Err(wrong("a table of plants and chances per column, such as { grass = 0.2 }"));
-                };
-                let mut total = 0.0;
-                for (name, chance) in table {
-                    let Some(&plant) = PLANTS.iter().find(|&&p| p == name) else {
-                        let suggestion = suggest_key(name, PLANTS);
-                        return Err((
-                            value.span(),
-                            Problem::UnknownName { what: "plant", name: name.clone(), suggestion },
-                        ));
-                    };
-                    let chance = number(chance).ok_or_else(|| wrong("a table of chances from 0 to 1"))?;
-                    let chance = share(plant, chance).map_err(|p| (value.span(), p))?;
-                    total += f64::from(chance);
-                    vegetation.plants.push((plant, chance));
-                }
+                let shape = "a table of plants and chances per column, such as { grass = 0.2 }";
+                vegetation.plants = chances(value.get_ref(), PLANTS, "plant")
+                    .ok_or_else(|| wrong(shape))?
+                    .map_err(|p| (value.span(), p))?;
+                let total: f64 = vegetation.plants.iter().map(|&(_, c)| f64::from(c)).sum();
                 if total > 1.0 + 1e-6 {
                     return Err((value.span(), Problem::PlantsOverOne { total }));
                 }
             }
             "water_plants" => {
-                let Value::Table(table) = value.get_ref() else {
-                    return Err(wrong("a table of water plants and chances, such as { seagrass = 0.3 }"));
-                };
-                for (name, chance) in table {
-                    let Some(&plant) = WATER_PLANTS.iter().find(|&&p| p == name) else {
-                        let suggestion = suggest_key(name, WATER_PLANTS);
-                        let problem = Problem::UnknownName { what: "water plant", name: name.clone(), suggestion };
-                        return Err((value.span(), problem));
-                    };
-                    let chance = number(chance).ok_or_else(|| wrong("a table of chances from 0 to 1"))?;
-                    vegetation.water_plants.push((plant, share(plant, chance).map_err(|p| (value.span(), p))?));
-                }
+                let shape = "a table of water plants and chances, such as { seagrass = 0.3 }";
+                vegetation.water_plants = chances(value.get_ref(), WATER_PLANTS, "water plant")
+                    .ok_or_else(|| wrong(shape))?
+                    .map_err(|p| (value.span(), p))?;
+                // Seagrass and kelp share a column's draw.
                 let floor: f32 = ["seagrass", "kelp"].iter().map(|&n| vegetation.water_plant(n)).sum();
                 if floor > 1.0 + 1e-6 {
                     return Err((value.span(), Problem::PlantsOverOne { total: f64::from(floor) }));
@@ -286,6 +267,29 @@ pub(crate) fn parse(body: &Body) -> Result<Vegetation, Mistake> {
         return Err((span, Problem::TreesWithoutSpecies));
     }
     Ok(vegetation)
+}
+
+/// A table of names from `known` (a `what`) and their chances, in the table's order: `None`
+/// when it is not a table of numbers, a problem for an unknown name or a chance outside 0 … 1.
+fn chances(
+    value: &Value,
+    known: &[&'static str],
+    what: &'static str,
+) -> Option<Result<Vec<(&'static str, f32)>, Problem>> {
+    let Value::Table(table) = value else { return None };
+    let mut out = Vec::with_capacity(table.len());
+    for (name, chance) in table {
+        let chance = number(chance)?;
+        let Some(&known_name) = known.iter().find(|&&p| p == name) else {
+            let suggestion = suggest_key(name, known);
+            return Some(Err(Problem::UnknownName { what, name: name.clone(), suggestion }));
+        };
+        match share(known_name, chance) {
+            Ok(c) => out.push((known_name, c)),
+            Err(p) => return Some(Err(p)),
+        }
+    }
+    Some(Ok(out))
 }
 
 /// A chance, checked to lie in `[0, 1]`.

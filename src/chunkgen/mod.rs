@@ -55,7 +55,6 @@ pub use palette::{vanilla_biome_names, BiomePalette};
 pub use plants::is_plant;
 pub use states::States;
 pub use surface::{Ground, Site};
-pub use trees::is_tree_part;
 pub use vertical::Vertical;
 
 /// Builds chunks for one world: the pipeline plus the vertical and climate settings.

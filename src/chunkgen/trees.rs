@@ -66,7 +66,7 @@ struct Part {
 }
 
 /// One tree.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Tree {
     /// Column of the trunk (the north-west one of a 2×2 trunk).
     pub x: i64,
@@ -85,6 +85,8 @@ pub struct Tree {
     shape: u64,
     /// Highest block above the ground it occupies.
     top: i32,
+    /// Its blocks, drawn once: every chunk it reaches places them from here.
+    parts: Vec<Part>,
 }
 
 /// The tree cells whose possible root lies within `REACH` of the chunk at block `(x0, z0)`:
@@ -127,11 +129,15 @@ pub fn is_wide(species: Species) -> bool {
     matches!(species, Species::DarkOak | Species::MegaSpruce | Species::MegaJungle)
 }
 
+/// The columns of a 2×2 trunk (offsets from its root, the north-west one).
+const TRUNK_2X2: [(i64, i64); 4] = [(0, 0), (1, 0), (0, 1), (1, 1)];
+
 /// The columns a 2×2 trunk stands on besides its root (offsets).
-pub const WIDE_TRUNK: [(i64, i64); 3] = [(1, 0), (0, 1), (1, 1)];
+pub const WIDE_TRUNK: [(i64, i64); 3] = [TRUNK_2X2[1], TRUNK_2X2[2], TRUNK_2X2[3]];
 
 /// True for the blocks trees are made of (logs, leaves, mangrove roots, vines, cocoa, huge
-/// mushrooms' stems and caps).
+/// mushrooms' stems and caps): what tests skip to find the ground.
+#[cfg(test)]
 pub fn is_tree_part(block: BlockState) -> bool {
     let name = block.to_kind().to_str();
     name.ends_with("_log")
@@ -169,8 +175,9 @@ impl Tree {
             Species::Cherry => 5 + a % 3,
             Species::HugeRedMushroom | Species::HugeBrownMushroom => 5 + a % 3,
         };
-        let mut tree = Tree { x, z, ground_y, species, wide, height, shape, top: 0 };
-        tree.top = tree.parts().iter().map(|p| p.dy).max().unwrap_or(0);
+        let mut tree = Tree { x, z, ground_y, species, wide, height, shape, top: 0, parts: Vec::new() };
+        tree.parts = tree.draw();
+        tree.top = tree.parts.iter().map(|p| p.dy).max().unwrap_or(0);
         tree
     }
 
@@ -183,14 +190,20 @@ impl Tree {
     #[cfg(test)]
     fn trunk_columns(&self) -> &'static [(i64, i64)] {
         if self.wide {
-            &[(0, 0), (1, 0), (0, 1), (1, 1)]
+            &TRUNK_2X2
         } else {
             &[(0, 0)]
         }
     }
 
-    /// Every block of the tree.
+    /// Every block of the tree (a copy, for tests).
+    #[cfg(test)]
     fn parts(&self) -> Vec<Part> {
+        self.parts.clone()
+    }
+
+    /// Draws every block of the tree from its species, height and shape hash.
+    fn draw(&self) -> Vec<Part> {
         let mut d = Draw::new(self.shape);
         let h = self.height;
         match (self.species, self.wide) {
@@ -460,7 +473,7 @@ impl Draw {
     /// Giant spruce: a 2×2 trunk under a long cone, widening down in alternating skirts.
     fn mega_spruce(&mut self, h: i32) {
         let leaves = BlockState::SPRUCE_LEAVES;
-        self.trunk(BlockState::SPRUCE_LOG, &[(0, 0), (1, 0), (0, 1), (1, 1)], 0, h);
+        self.trunk(BlockState::SPRUCE_LOG, &TRUNK_2X2, 0, h);
         let crown = h / 2 + 2;
         for i in 0..crown {
             // A cap over the trunk, then skirts of at least radius 1 around it.
@@ -476,7 +489,7 @@ impl Draw {
     /// broad crown.
     fn mega_jungle(&mut self, h: i32) {
         let (log, leaves) = (BlockState::JUNGLE_LOG, BlockState::JUNGLE_LEAVES);
-        self.trunk(log, &[(0, 0), (1, 0), (0, 1), (1, 1)], 0, h);
+        self.trunk(log, &TRUNK_2X2, 0, h);
         self.layer(leaves, (0, 0), h + 1, 1, true, Corners::Drop);
         self.layer(leaves, (0, 0), h, 2, true, Corners::Round);
         self.layer(leaves, (0, 0), h - 1, 3, true, Corners::Round);
@@ -525,7 +538,7 @@ impl Draw {
     /// Dark oak: a 2×2 trunk under a broad, low, irregular crown.
     fn dark_oak(&mut self, h: i32) {
         let leaves = BlockState::DARK_OAK_LEAVES;
-        self.trunk(BlockState::DARK_OAK_LOG, &[(0, 0), (1, 0), (0, 1), (1, 1)], 0, h);
+        self.trunk(BlockState::DARK_OAK_LOG, &TRUNK_2X2, 0, h);
         self.layer(leaves, (0, 0), h - 2, 2, true, Corners::Random);
         self.layer(leaves, (0, 0), h - 1, 3, true, Corners::Round);
         self.layer(leaves, (0, 0), h, 2, true, Corners::Round);
@@ -649,10 +662,9 @@ fn facing(ox: i64, oz: i64) -> PropValue {
 /// column is (`x0`, `z0`) and whose floor is `min_y`, layer by layer over all trees.
 pub fn place(chunk: &mut UnloadedChunk, trees: &[Tree], x0: i64, z0: i64, min_y: i32) {
     let height = chunk.height() as i32;
-    let parts: Vec<Vec<Part>> = trees.iter().map(Tree::parts).collect();
     for layer in [Layer::Wood, Layer::Roots, Layer::Leaves, Layer::Hanging] {
-        for (t, parts) in trees.iter().zip(&parts) {
-            for p in parts.iter().filter(|p| p.layer == layer) {
+        for t in trees {
+            for p in t.parts.iter().filter(|p| p.layer == layer) {
                 let (lx, lz, ly) = (t.x + p.dx - x0, t.z + p.dz - z0, t.ground_y + p.dy - min_y);
                 if !((0..16).contains(&lx) && (0..16).contains(&lz) && (0..height).contains(&ly)) {
                     continue;
@@ -820,8 +832,8 @@ mod tests {
             let mut left = UnloadedChunk::with_height(128);
             let mut right = UnloadedChunk::with_height(128);
             let mut whole = UnloadedChunk::with_height(128);
-            place(&mut left, &[tree], 0, 0, 0);
-            place(&mut right, &[tree], 16, 0, 0);
+            place(&mut left, std::slice::from_ref(&tree), 0, 0, 0);
+            place(&mut right, std::slice::from_ref(&tree), 16, 0, 0);
             // The same tree 8 blocks further west, whole in one chunk.
             let moved = Tree::new(3, 15, 8, 60, species, true);
             let moved = Tree { x: 7, ..moved };
@@ -862,7 +874,7 @@ mod tests {
         let leaf = tree.parts().into_iter().find(|p| p.layer == Layer::Leaves).expect("leaves");
         let (sx, sy, sz) = ((8 + leaf.dx) as u32, (60 + leaf.dy) as u32, (8 + leaf.dz) as u32);
         chunk.set_block_state(sx, sy, sz, BlockState::STONE);
-        place(&mut chunk, &[tree], 0, 0, 0);
+        place(&mut chunk, std::slice::from_ref(&tree), 0, 0, 0);
         let root = chunk.block_state(8, 61, 8);
         assert_eq!(root.to_kind().to_str(), "mangrove_roots");
         assert_eq!(root.get(PropName::Waterlogged), Some(PropValue::True));
