@@ -1,5 +1,6 @@
 //! What the repository ships, compiled into the binary so an installed `infiniterra` runs
-//! from any directory: the configuration file, the default biome rules with their surfaces, veins and vegetation, and the trained
+//! from any directory: the configuration file, the default biome rules with their surfaces,
+//! veins and vegetation, and the trained
 //! models (a few MB). A file on disk always wins over these (the lookup order is in
 //! [`find`](super::find)).
 
