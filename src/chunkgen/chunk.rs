@@ -7,7 +7,7 @@ use valence::prelude::UnloadedChunk;
 use crate::biome::BiomeRules;
 
 use super::passes::{Pass, PASSES};
-use super::{BiomePalette, ChunkContext, Generator};
+use super::{BiomePalette, Blocks, ChunkContext, Generator};
 
 /// Blocks per chunk edge.
 pub const CHUNK: i64 = 16;
@@ -26,10 +26,16 @@ impl Generator {
     /// numbered by `palette`. Pure: the same inputs give the same chunk, and neighbouring chunks
     /// meet without seams (everything is a function of global coordinates).
     pub fn chunk(&self, rules: &BiomeRules, palette: &BiomePalette, chunk_x: i32, chunk_z: i32) -> UnloadedChunk {
+        self.blocks(rules, palette, chunk_x, chunk_z).to_chunk()
+    }
+
+    /// [`chunk`](Self::chunk) as plain arrays, before valence's paletted form: what
+    /// pre-generation encodes and light is computed from.
+    pub fn blocks(&self, rules: &BiomeRules, palette: &BiomePalette, chunk_x: i32, chunk_z: i32) -> Blocks {
         self.run_passes(rules, palette, chunk_x, chunk_z, |_, _| {})
     }
 
-    /// [`chunk`](Self::chunk), also reporting the time each pass took, in pass order (for
+    /// [`blocks`](Self::blocks), also reporting the time each pass took, in pass order (for
     /// benchmarks: the cost per pass).
     pub fn chunk_timed(
         &self,
@@ -37,7 +43,7 @@ impl Generator {
         palette: &BiomePalette,
         chunk_x: i32,
         chunk_z: i32,
-    ) -> (UnloadedChunk, Vec<PassTiming>) {
+    ) -> (Blocks, Vec<PassTiming>) {
         let mut timings = Vec::with_capacity(PASSES.len());
         let chunk = self.run_passes(rules, palette, chunk_x, chunk_z, |pass, nanos| {
             timings.push(PassTiming { name: pass.name, nanos });
@@ -53,9 +59,9 @@ impl Generator {
         chunk_x: i32,
         chunk_z: i32,
         mut timed: impl FnMut(&Pass, u64),
-    ) -> UnloadedChunk {
+    ) -> Blocks {
         let mut ctx = ChunkContext::new(self, rules, palette, chunk_x, chunk_z);
-        let mut chunk = UnloadedChunk::with_height(self.vertical.height as u32);
+        let mut chunk = Blocks::with_height(self.vertical.height as u32);
         for pass in &PASSES {
             let start = Instant::now();
             (pass.run)(&mut ctx, &mut chunk);

@@ -14,7 +14,7 @@
 //! finished blocks ([`Light::of`]).
 //!
 //! Adding a pass (see docs/architecture.md, "Where to add: A chunk-generation pass"): write
-//! `passes/<name>.rs` with `pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk)` and
+//! `passes/<name>.rs` with `pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks)` and
 //! its own unit tests, then add it to [`passes::PASSES`] at its place in the order (the list
 //! marks where carvers and ores go). A pass must stay a pure function of the context and the
 //! chunk so far: anything it decides near a chunk border must be decided the same way by the
@@ -25,6 +25,7 @@
 //!
 //! [`UnloadedChunk`]: valence::prelude::UnloadedChunk
 
+mod blocks;
 mod cave_field;
 mod cells;
 mod chunk;
@@ -46,6 +47,7 @@ use std::sync::Arc;
 use crate::config::Config;
 use crate::terrain::Pipeline;
 
+pub use blocks::Blocks;
 pub use chunk::{PassTiming, CHUNK};
 pub use columns::Columns;
 pub use context::ChunkContext;

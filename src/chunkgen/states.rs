@@ -32,6 +32,12 @@ impl States {
         States { height, ids }
     }
 
+    /// States from raw ids already in section order (`height · 256` of them).
+    pub(crate) fn from_ids(height: u32, ids: Vec<u16>) -> States {
+        assert_eq!(ids.len(), height as usize * 256, "a chunk {height} blocks tall");
+        States { height, ids }
+    }
+
     /// Height of the chunk, blocks.
     pub fn height(&self) -> u32 {
         self.height

@@ -19,7 +19,9 @@
 //! air), then what hangs from them (vines, cocoa, hanging leaves, into air) — so the result
 //! does not depend on which chunk is built first.
 
-use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk, PropName, PropValue};
+
+use crate::chunkgen::Blocks;
 
 use crate::biome::Species;
 
@@ -660,7 +662,7 @@ fn facing(ox: i64, oz: i64) -> PropValue {
 
 /// Places `trees` (in the order given, which must be global) into the chunk whose first
 /// column is (`x0`, `z0`) and whose floor is `min_y`, layer by layer over all trees.
-pub fn place(chunk: &mut UnloadedChunk, trees: &[Tree], x0: i64, z0: i64, min_y: i32) {
+pub fn place(chunk: &mut Blocks, trees: &[Tree], x0: i64, z0: i64, min_y: i32) {
     let height = chunk.height() as i32;
     for layer in [Layer::Wood, Layer::Roots, Layer::Leaves, Layer::Hanging] {
         for t in trees {
@@ -829,9 +831,9 @@ mod tests {
     fn a_tree_split_across_chunks_matches_the_tree_placed_whole() {
         for species in Species::ALL {
             let tree = Tree::new(3, 15, 8, 60, species, true);
-            let mut left = UnloadedChunk::with_height(128);
-            let mut right = UnloadedChunk::with_height(128);
-            let mut whole = UnloadedChunk::with_height(128);
+            let mut left = Blocks::with_height(128);
+            let mut right = Blocks::with_height(128);
+            let mut whole = Blocks::with_height(128);
             place(&mut left, std::slice::from_ref(&tree), 0, 0, 0);
             place(&mut right, std::slice::from_ref(&tree), 16, 0, 0);
             // The same tree 8 blocks further west, whole in one chunk.
@@ -863,7 +865,7 @@ mod tests {
     #[test]
     fn roots_in_water_are_waterlogged_and_leaves_never_replace_ground() {
         let tree = Tree::new(5, 8, 8, 60, Species::Mangrove, false);
-        let mut chunk = UnloadedChunk::with_height(128);
+        let mut chunk = Blocks::with_height(128);
         // Water two blocks deep over the ground, and a stone block where a leaf would go.
         for x in 0..16 {
             for z in 0..16 {
@@ -938,7 +940,7 @@ mod picture {
             let (column, row) = ((i % per_row) as i64, (i / per_row) as u32);
             let x = column * slot + slot / 2;
             let tree = Tree::new(11 + i as u64, x, 8, ground, s, true);
-            let mut chunk = UnloadedChunk::with_height(height + 8);
+            let mut chunk = Blocks::with_height(height + 8);
             let x0 = x - 8;
             place(&mut chunk, &[tree], x0, 0, 0);
             for lx in 0..16u32 {

@@ -9,7 +9,7 @@ use valence::prelude::UnloadedChunk;
 use super::codec::{Decoder, Encoder};
 use super::store::{Store, StoreError};
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, Light, States};
+use crate::chunkgen::{BiomePalette, Generator, Light};
 
 /// Where a chunk came from.
 #[derive(Clone, Debug, PartialEq)]
@@ -66,9 +66,9 @@ impl ChunkSource {
     /// the store.
     pub fn get(&self, scratch: &mut Scratch, rules: &BiomeRules, x: i32, z: i32) -> (UnloadedChunk, Light, Origin) {
         let Some(store) = &self.store else {
-            let chunk = self.generator.chunk(rules, &self.palette, x, z);
-            let light = Light::of(&chunk);
-            return (chunk, light, Origin::Generated);
+            let blocks = self.generator.blocks(rules, &self.palette, x, z);
+            let light = Light::of_states(&blocks.states());
+            return (blocks.to_chunk(), light, Origin::Generated);
         };
         let origin = match store.load(x, z) {
             Ok(None) => Origin::Generated,
@@ -81,14 +81,14 @@ impl ChunkSource {
             },
             Err(e) => Origin::Regenerated(e.to_string()),
         };
-        let chunk = self.generator.chunk(rules, &self.palette, x, z);
-        let states = States::of(&chunk);
+        let blocks = self.generator.blocks(rules, &self.palette, x, z);
+        let states = blocks.states();
         let light = Light::of_states(&states);
-        let nbt = scratch.encoder.encode_states(x, z, &chunk, &states, &light);
+        let nbt = scratch.encoder.encode_states(x, z, &blocks, &states, &light);
         if let Err(e) = store.save(x, z, &nbt) {
             tracing::error!("{e}");
         }
-        (chunk, light, origin)
+        (blocks.to_chunk(), light, origin)
     }
 
     /// Makes sure chunk (`x`, `z`) is saved: a chunk already in its region file is left as it
@@ -99,10 +99,11 @@ impl ChunkSource {
         if store.contains(x, z)? {
             return Ok(false);
         }
-        let chunk = self.generator.chunk(rules, &self.palette, x, z);
-        let states = States::of(&chunk);
+        // Encoded from the generator's arrays: no paletted chunk is built at all.
+        let blocks = self.generator.blocks(rules, &self.palette, x, z);
+        let states = blocks.states();
         let light = Light::of_states(&states);
-        let nbt = scratch.encoder.encode_states(x, z, &chunk, &states, &light);
+        let nbt = scratch.encoder.encode_states(x, z, &blocks, &states, &light);
         store.save(x, z, &nbt)?;
         Ok(true)
     }

@@ -7,7 +7,9 @@
 //! Like every pass, a pure function of global coordinates: each choice hashes (seed, x, z)
 //! and reads only the column and its four neighbours, which the columns pass provides.
 
-use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk, PropName, PropValue};
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::columns::Water;
@@ -51,7 +53,7 @@ pub const LILY_PAD_MAX_M3S: f32 = 20.0;
 pub const MANGROVE_MAX_DEPTH: i32 = 3;
 
 /// Places the aquatic plants of every column of the chunk.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let (v, seed, columns, cells_y) = (*ctx.vertical(), ctx.seed(), ctx.columns(), ctx.cells_y());
     for (lx, lz, x, z) in ctx.each_column() {
         let ground = columns.surface_y(x, z);
@@ -166,7 +168,7 @@ mod tests {
 
     /// Runs the rock-less passes that aquatic plants need (water, surface) over synthetic
     /// columns, then this pass.
-    fn grow(f: impl Fn(i64, i64) -> (f32, f32), biome: &str) -> (UnloadedChunk, crate::chunkgen::Vertical) {
+    fn grow(f: impl Fn(i64, i64) -> (f32, f32), biome: &str) -> (Blocks, crate::chunkgen::Vertical) {
         grow_at((0, 0), f, biome)
     }
 
@@ -175,21 +177,21 @@ mod tests {
         (cx, cz): (i32, i32),
         f: impl Fn(i64, i64) -> (f32, f32),
         biome: &str,
-    ) -> (UnloadedChunk, crate::chunkgen::Vertical) {
+    ) -> (Blocks, crate::chunkgen::Vertical) {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, cx, cz);
         let (x0, z0) = (i64::from(cx) * 16, i64::from(cz) * 16);
         ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 5, x0 - 5, 26, 26), f));
         ctx.biomes = vec![biome; 16 * ctx.cells_y()];
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         super::super::water::run(&mut ctx, &mut chunk);
         super::super::surface::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);
         (chunk, v)
     }
 
-    fn count(chunk: &UnloadedChunk, v: &crate::chunkgen::Vertical, block: BlockState) -> usize {
+    fn count(chunk: &Blocks, v: &crate::chunkgen::Vertical, block: BlockState) -> usize {
         (0..16u32)
             .flat_map(|x| (0..16u32).map(move |z| (x, z)))
             .flat_map(|(x, z)| (0..v.height as u32).map(move |y| (x, y, z)))
@@ -288,7 +290,7 @@ mod tests {
             }
         }));
         ctx.biomes = vec!["minecraft:plains"; 16 * ctx.cells_y()];
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         super::super::water::run(&mut ctx, &mut chunk);
         super::super::surface::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);

@@ -4,7 +4,9 @@
 //! up to its ceiling: under the ground, clear of water, or through the ground in entrance
 //! patches (cave mouths).
 
-use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk};
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::cave_field::{ceiling, density, interpolate, widening, LATTICE, LATTICE_Y, MOUTH_DEPTH};
 use crate::chunkgen::{ChunkContext, CHUNK};
@@ -15,7 +17,7 @@ pub const LAVA_Y: i32 = -55;
 const FLOOR_KEEP: i32 = 5;
 
 /// Carves the chunk's caves (air, lava at [`LAVA_Y`] and below).
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let v = *ctx.vertical();
     let columns = ctx.columns();
     // The highest Y each column may be carved to.
@@ -82,7 +84,7 @@ struct Carve<'a> {
 /// Carves the blocks of one lattice cell whose interpolated density (widened in entrance
 /// patches) is positive.
 fn carve_cell(
-    chunk: &mut UnloadedChunk,
+    chunk: &mut Blocks,
     c: &[f32; 8],
     (i, j, k): (usize, usize, usize),
     ly0: i64,
@@ -129,13 +131,13 @@ mod tests {
     use crate::terrain::Rect;
 
     /// A chunk of rock up to `ground(x)` with the sea pass run, then this pass.
-    fn carved(seed_chunk: (i32, i32), ground: impl Fn(i64) -> f32) -> (UnloadedChunk, crate::chunkgen::Vertical) {
+    fn carved(seed_chunk: (i32, i32), ground: impl Fn(i64) -> f32) -> (Blocks, crate::chunkgen::Vertical) {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome("minecraft:plains"));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, seed_chunk.0, seed_chunk.1);
         let (x0, z0) = (ctx.x0, ctx.z0);
         ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 5, x0 - 5, 26, 26), |x, _| (ground(x), 10.0)));
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         super::super::rock::run(&mut ctx, &mut chunk);
         super::super::water::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);

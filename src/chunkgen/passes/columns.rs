@@ -1,7 +1,9 @@
 //! The columns pass: asks the pipeline for the chunk's columns and decides the biome of every
 //! 4×4×4 cell, writing the biomes into the chunk.
 
-use valence::prelude::{Chunk, UnloadedChunk};
+use valence::prelude::Chunk;
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::columns::Columns;
@@ -12,7 +14,7 @@ use crate::terrain::Rect;
 /// Fills `ctx.columns` (the chunk plus a border: trees rooted up to `REACH` outside it, plus
 /// one column for slopes and steepness at the edges) and `ctx.biomes`, and sets every biome
 /// cell of `chunk`.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let pad = trees::REACH + 1;
     let rect = Rect::new(ctx.z0 - pad, ctx.x0 - pad, CHUNK + 2 * pad, CHUNK + 2 * pad);
     let columns = Columns::query(ctx.generator.pipeline(), ctx.vertical(), rect);
@@ -65,7 +67,7 @@ mod tests {
         let (g, palette) = (testing::generator(), testing::palette());
         let rules = testing::single_biome("minecraft:forest");
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 2, -3);
-        let mut chunk = UnloadedChunk::with_height(g.vertical().height as u32);
+        let mut chunk = Blocks::with_height(g.vertical().height as u32);
         run(&mut ctx, &mut chunk);
         let r = ctx.columns().rect();
         assert_eq!(

@@ -5,7 +5,9 @@
 //! Where they stand is a smooth noise over the sea (patches about 20 blocks across, a few in
 //! a hundred columns), a pure function of the column: bergs cross chunk borders whole.
 
-use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk};
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::columns::Water;
 use crate::chunkgen::hash::value_noise;
@@ -31,7 +33,7 @@ pub fn berg_height(seed: u64, x: i64, z: i64) -> Option<i32> {
 }
 
 /// Raises the bergs.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let (v, seed, columns) = (*ctx.vertical(), ctx.seed(), ctx.columns());
     let height = v.min_y + v.height;
     for (lx, lz, x, z) in ctx.each_column() {
@@ -63,13 +65,13 @@ mod tests {
     use crate::terrain::Rect;
 
     /// Chunk (`cx`, `cz`) of sea 600 m deep, frozen where `frozen`, with its water and bergs.
-    fn sea(g: &crate::chunkgen::Generator, (cx, cz): (i32, i32), frozen: bool) -> UnloadedChunk {
+    fn sea(g: &crate::chunkgen::Generator, (cx, cz): (i32, i32), frozen: bool) -> Blocks {
         let (palette, rules) = (testing::palette(), testing::single_biome("minecraft:frozen_ocean"));
         let mut ctx = ChunkContext::new(g, &rules, &palette, cx, cz);
         let (x0, z0) = (i64::from(cx) * 16, i64::from(cz) * 16);
         let t = if frozen { -8.0 } else { 5.0 };
         ctx.columns = Some(testing::columns(g, Rect::new(z0 - 5, x0 - 5, 26, 26), |_, _| (-600.0, t)));
-        let mut chunk = UnloadedChunk::with_height(g.vertical().height as u32);
+        let mut chunk = Blocks::with_height(g.vertical().height as u32);
         water::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);
         chunk

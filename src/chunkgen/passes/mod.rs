@@ -17,7 +17,7 @@ mod surface;
 mod vegetation;
 mod water;
 
-use valence::prelude::UnloadedChunk;
+use crate::chunkgen::Blocks;
 
 use super::ChunkContext;
 
@@ -28,7 +28,7 @@ pub struct Pass {
     /// Short name (`"rock"`), as benchmarks report it.
     pub name: &'static str,
     /// Runs the pass: reads and extends the context, writes blocks or biomes into the chunk.
-    pub run: fn(&mut ChunkContext, &mut UnloadedChunk),
+    pub run: fn(&mut ChunkContext, &mut Blocks),
 }
 
 /// Every pass, in order.

@@ -10,7 +10,9 @@
 //! whatever order chunks are built in. A vein replaces only stone or deepslate (its deepslate
 //! variant in deepslate), never air, water, lava or the ground's own blocks.
 
-use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk};
+
+use crate::chunkgen::Blocks;
 
 use crate::biome::{Vein, VeinHeight};
 use crate::chunkgen::hash::hash3;
@@ -110,7 +112,7 @@ fn reach(size: u32) -> i64 {
 }
 
 /// Writes every vein that starts in this chunk or a neighbour into this chunk.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let v = *ctx.vertical();
     let (seed, columns) = (ctx.seed(), ctx.columns());
     let (cx, cz) = (ctx.x0.div_euclid(CHUNK), ctx.z0.div_euclid(CHUNK));
@@ -176,15 +178,7 @@ pub fn starts(seed: u64, kind: u64, (cx, cz): (i64, i64), ore: &Vein) -> Vec<(i6
 /// One vein of vanilla's `ore.size`, as many blocks as vanilla's place on average: the blocks
 /// within the vein's ball around its start, each block's distance jittered so veins are
 /// lumpy, written where they fall inside the chunk.
-fn place_vein(
-    chunk: &mut UnloadedChunk,
-    x0: i64,
-    z0: i64,
-    min_y: i32,
-    ore: &Vein,
-    salt: u64,
-    (sx, sy, sz): (i64, i32, i64),
-) {
+fn place_vein(chunk: &mut Blocks, x0: i64, z0: i64, min_y: i32, ore: &Vein, salt: u64, (sx, sy, sz): (i64, i32, i64)) {
     let (r, r2) = (reach(ore.size), radius2(ore.size));
     for dy in -r..=r {
         let ly = i64::from(sy) + dy - i64::from(min_y);
@@ -224,13 +218,13 @@ mod tests {
     use crate::terrain::Rect;
 
     /// Chunk (`cx`, `cz`) of solid rock up to 2,000 m (Y 143), with this pass run.
-    fn ores_in(cx: i32, cz: i32) -> UnloadedChunk {
+    fn ores_in(cx: i32, cz: i32) -> Blocks {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome("minecraft:plains"));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, cx, cz);
         let (x0, z0) = (ctx.x0, ctx.z0);
         ctx.columns = Some(testing::columns(&g, Rect::new(z0 - 5, x0 - 5, 26, 26), |_, _| (2000.0, 10.0)));
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         super::super::rock::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);
         chunk
@@ -289,7 +283,7 @@ mod tests {
     #[test]
     fn ores_sit_at_their_depths_in_their_host_rock_and_veins_cross_chunk_borders() {
         let v = *testing::generator().vertical();
-        let chunks: Vec<UnloadedChunk> = (0..4).map(|cx| ores_in(cx, 2)).collect();
+        let chunks: Vec<Blocks> = (0..4).map(|cx| ores_in(cx, 2)).collect();
         let at = |x: i64, y: i32, z: u32| {
             let c = &chunks[x.div_euclid(16) as usize];
             c.block_state(x.rem_euclid(16) as u32, (y - v.min_y) as u32, z)

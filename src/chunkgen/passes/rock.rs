@@ -4,7 +4,9 @@
 //! blocks and deepslate over Y 0 … 8, each block drawn by a hash of its position (so chunks
 //! agree on their borders and a world is the same in any order).
 
-use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk};
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::hash::unit3;
 use crate::chunkgen::ChunkContext;
@@ -23,7 +25,7 @@ const SALT_BEDROCK: u64 = 0x6265_6472;
 const SALT_DEEPSLATE: u64 = 0x6465_6570;
 
 /// Fills every column with rock from the floor to its surface block.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let (v, seed) = (*ctx.vertical(), ctx.seed());
     let columns = ctx.columns();
     let min_surface = ctx.each_column().map(|(_, _, x, z)| columns.surface_y(x, z)).min().unwrap_or(v.min_y);
@@ -88,7 +90,7 @@ mod tests {
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
         // Ground rising 25 m (one block) per column eastwards from Y 63.
         ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |x, _| (x.max(0) as f32 * 25.0, 10.0)));
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         run(&mut ctx, &mut chunk);
         let count = |y: i32, block: BlockState| {
             (0..16u32)

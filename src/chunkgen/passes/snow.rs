@@ -2,7 +2,9 @@
 //! the ground, a tree's crown — as vanilla's freeze step lays it, with grass under it turned
 //! to its snowy face. Water keeps its ice (the water pass's) and plants stay bare.
 
-use valence::prelude::{BlockState, Chunk, PropName, PropValue, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk, PropName, PropValue};
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::{is_plant, ChunkContext};
 
@@ -17,7 +19,7 @@ pub fn snowy(biome: &str) -> bool {
 }
 
 /// Lays the snow.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     // Most chunks have no snowy cell at all: skip their columns' biome lookups.
     if !ctx.biomes.iter().any(|b| snowy(b)) {
         return;
@@ -54,20 +56,20 @@ mod tests {
     use crate::terrain::Rect;
 
     /// Flat land at Y 67 in `biome` with its ground, trees and plants, then snow.
-    fn snowed(biome: &'static str) -> UnloadedChunk {
+    fn snowed(biome: &'static str) -> Blocks {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
         ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |_, _| (100.0, 0.0)));
         ctx.biomes = vec![biome; 16 * ctx.cells_y()];
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         surface::run(&mut ctx, &mut chunk);
         vegetation::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);
         chunk
     }
 
-    fn top(chunk: &UnloadedChunk, x: u32, z: u32) -> (u32, BlockState) {
+    fn top(chunk: &Blocks, x: u32, z: u32) -> (u32, BlockState) {
         let y = (0..chunk.height()).rev().find(|&y| !chunk.block_state(x, y, z).is_air()).expect("a block");
         (y, chunk.block_state(x, y, z))
     }

@@ -2,7 +2,9 @@
 //! the cell holding its ground, its steepness, temperature and water depth (see
 //! `chunkgen/surface.rs` for the choice), laid over the rock.
 
-use valence::prelude::{Chunk, UnloadedChunk};
+use valence::prelude::Chunk;
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::cave_field;
 use crate::chunkgen::cells::{self, CELL};
@@ -13,7 +15,7 @@ use super::rock::MAX_GROUND_DEPTH;
 
 /// Replaces the top of every column's rock with its ground: the top block, then the filler
 /// (or terracotta bands) below it. The bedrock floor stays.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let v = *ctx.vertical();
     let (columns, cells_y) = (ctx.columns(), ctx.cells_y());
     for (lx, lz, x, z) in ctx.each_column() {
@@ -49,7 +51,7 @@ mod tests {
     use super::*;
     use crate::terrain::Rect;
 
-    fn surface_of(biome: &str, elevation: f32) -> (UnloadedChunk, i32) {
+    fn surface_of(biome: &str, elevation: f32) -> (Blocks, i32) {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
@@ -57,7 +59,7 @@ mod tests {
         let ground_y = columns.surface_y(5, 5);
         ctx.columns = Some(columns);
         ctx.biomes = vec![biome; 16 * ctx.cells_y()];
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         run(&mut ctx, &mut chunk);
         (chunk, ground_y - v.min_y)
     }
@@ -83,7 +85,7 @@ mod tests {
     #[test]
     fn the_bedrock_floor_stays() {
         // Ground at the lowest surface Y: its filler would reach below the floor.
-        let (mut chunk, y) = (UnloadedChunk::with_height(384), 1);
+        let (mut chunk, y) = (Blocks::with_height(384), 1);
         chunk.set_block_state(5, 0, 5, BlockState::BEDROCK);
         let (g, palette, rules) =
             (testing::generator(), testing::palette(), testing::single_biome("minecraft:badlands"));

@@ -1,13 +1,15 @@
 //! The vegetation pass: trees rooted in or near the chunk, then one plant at most per column
 //! where every block it needs is still air.
 
-use valence::prelude::{Chunk, UnloadedChunk};
+use valence::prelude::Chunk;
+
+use crate::chunkgen::Blocks;
 
 use crate::chunkgen::trees;
 use crate::chunkgen::{ChunkContext, CHUNK};
 
 /// Places every tree reaching into the chunk, then the plants.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let (g, v, columns) = (ctx.generator, *ctx.vertical(), ctx.columns());
     let trees = g.trees(ctx.rules, columns, ctx.x0, ctx.z0, CHUNK);
     trees::place(chunk, &trees, ctx.x0, ctx.z0, v.min_y);
@@ -35,12 +37,12 @@ mod tests {
     use crate::terrain::Rect;
 
     /// Flat land at Y 67 in `biome`, with only the ground blocks the vegetation looks at.
-    fn vegetate(biome: &str) -> UnloadedChunk {
+    fn vegetate(biome: &str) -> Blocks {
         let (g, palette, rules) = (testing::generator(), testing::palette(), testing::single_biome(biome));
         let v = *g.vertical();
         let mut ctx = ChunkContext::new(&g, &rules, &palette, 0, 0);
         ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |_, _| (100.0, 15.0)));
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         run(&mut ctx, &mut chunk);
         chunk
     }

@@ -2,7 +2,9 @@
 //! water top (frozen on top where the column is colder than the ice threshold), and falling
 //! water where a river steps down from one column to the next.
 
-use valence::prelude::{BlockState, Chunk, UnloadedChunk};
+use valence::prelude::{BlockState, Chunk};
+
+use crate::chunkgen::Blocks;
 use valence::prelude::{PropName, PropValue};
 
 use crate::chunkgen::surface::SEA_ICE_C;
@@ -17,7 +19,7 @@ pub fn falling_water() -> BlockState {
 
 /// Fills every wet column with water from its ground up to its water top (ice on top where
 /// cold), and the side of each step down with falling water.
-pub fn run(ctx: &mut ChunkContext, chunk: &mut UnloadedChunk) {
+pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let v = *ctx.vertical();
     let columns = ctx.columns();
     for (lx, lz, x, z) in ctx.each_column() {
@@ -57,7 +59,7 @@ mod tests {
         ctx.columns = Some(testing::columns(&g, Rect::new(-5, -5, 26, 26), |x, z| {
             (if x < 8 { -600.0 } else { 100.0 }, if z < 8 { -5.0 } else { 10.0 })
         }));
-        let mut chunk = UnloadedChunk::with_height(v.height as u32);
+        let mut chunk = Blocks::with_height(v.height as u32);
         run(&mut ctx, &mut chunk);
         let at = |x: u32, y: i32, z: u32| chunk.block_state(x, (y - v.min_y) as u32, z);
         assert!(at(2, 52, 2).is_air(), "the ground is not the water pass's");

@@ -8,7 +8,7 @@ use valence::prelude::{ChunkPos, ChunkView};
 
 use super::Measurement;
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, Light, States};
+use crate::chunkgen::{BiomePalette, Generator, Light};
 use crate::config::Config;
 use crate::pregen::{run_to_end, Hooks, Job, Plan, Shape, Shard, Task};
 use crate::terrain::Pipeline;
@@ -156,7 +156,7 @@ fn per_chunk(generator: &Generator, rules: &BiomeRules, task: Task, label: &str,
         }
         let t = Instant::now();
         // Reading the blocks counts with light, as the first to need them.
-        let states = States::of(&chunk);
+        let states = chunk.states();
         let sky = Light::of_states(&states);
         light += t.elapsed().as_secs_f64();
         let t = Instant::now();

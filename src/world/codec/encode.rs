@@ -68,7 +68,7 @@ impl Encoder {
         &mut self,
         chunk_x: i32,
         chunk_z: i32,
-        chunk: &UnloadedChunk,
+        chunk: &impl Chunk,
         states: &States,
         light: &Light,
     ) -> Vec<u8> {
@@ -161,7 +161,7 @@ impl Encoder {
     }
 
     /// Writes the `biomes` compound of section `s`.
-    fn biomes(&mut self, w: &mut Writer, chunk: &UnloadedChunk, s: u32) {
+    fn biomes(&mut self, w: &mut Writer, chunk: &impl Chunk, s: u32) {
         self.biome_palette.clear();
         let mut i = 0;
         for y in s * 4..s * 4 + 4 {
