@@ -58,6 +58,19 @@ pub struct EngineStats {
     pub cached_windows: usize,
 }
 
+/// What one window function (one [`WindowFn`](super::WindowFn) by name) has cost so far.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FunctionStats {
+    /// The function's name ([`WindowFn::name`](super::WindowFn::name)).
+    pub name: String,
+    /// Windows it evaluated (recomputations after eviction included).
+    pub windows: u64,
+    /// Seconds its evaluations took, summed over threads: inclusive, so a function that
+    /// queries another (the drainage reads the learned relief) counts the windows it waited
+    /// for too.
+    pub seconds: f64,
+}
+
 struct State {
     lru: LruCache<WindowKey, Arc<[f32]>>,
     bytes: usize,
@@ -85,6 +98,8 @@ pub struct Engine {
     threads: usize,
     next_id: AtomicU32,
     evaluated: AtomicU64,
+    /// Per registered tensor (index: its id).
+    functions: Mutex<Vec<FunctionStats>>,
 }
 
 impl Engine {
@@ -104,6 +119,7 @@ impl Engine {
             threads: config.threads.max(1),
             next_id: AtomicU32::new(0),
             evaluated: AtomicU64::new(0),
+            functions: Mutex::new(Vec::new()),
         })
     }
 
@@ -137,12 +153,39 @@ impl Engine {
         s.bytes = 0;
     }
 
-    pub(crate) fn register(&self) -> u32 {
-        self.next_id.fetch_add(1, Ordering::Relaxed)
+    /// What each window function has evaluated so far and how long it took, one entry per
+    /// name, in the order they were first registered (where a query's time goes).
+    pub fn function_stats(&self) -> Vec<FunctionStats> {
+        let functions = self.functions.lock().unwrap_or_else(|e| e.into_inner());
+        let mut out: Vec<FunctionStats> = Vec::new();
+        for f in functions.iter() {
+            match out.iter_mut().find(|o| o.name == f.name) {
+                Some(o) => {
+                    o.windows += f.windows;
+                    o.seconds += f.seconds;
+                }
+                None => out.push(f.clone()),
+            }
+        }
+        out
     }
 
-    pub(crate) fn count_evaluations(&self, n: usize) {
+    pub(crate) fn register(&self, name: &str) -> u32 {
+        let mut functions = self.functions.lock().unwrap_or_else(|e| e.into_inner());
+        let id = self.next_id.fetch_add(1, Ordering::Relaxed);
+        debug_assert_eq!(id as usize, functions.len());
+        functions.push(FunctionStats { name: name.to_string(), windows: 0, seconds: 0.0 });
+        id
+    }
+
+    /// Tensor `id` evaluated `n` windows in `seconds`.
+    pub(crate) fn count_evaluations(&self, id: u32, n: usize, seconds: f64) {
         self.evaluated.fetch_add(n as u64, Ordering::Relaxed);
+        let mut functions = self.functions.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(f) = functions.get_mut(id as usize) {
+            f.windows += n as u64;
+            f.seconds += seconds;
+        }
     }
 
     fn lock(&self) -> MutexGuard<'_, State> {

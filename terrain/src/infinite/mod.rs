@@ -10,7 +10,7 @@ mod tensor;
 mod tiled;
 mod window;
 
-pub use engine::{cache_capacity_hint, Engine, EngineConfig, EngineStats};
+pub use engine::{cache_capacity_hint, Engine, EngineConfig, EngineStats, FunctionStats};
 pub use tensor::{WindowFn, Windowed};
 pub use tiled::tiled;
 pub use window::{Axis, WindowIndex, WindowLayout, EDGE_WEIGHT};

@@ -49,7 +49,7 @@ impl Windowed {
             panic!("window layout of {}: {e}", f.name());
         }
         Arc::new(Windowed {
-            id: engine.register(),
+            id: engine.register(f.name()),
             weight_y: layout.y.tent(),
             weight_x: layout.x.tent(),
             layout,
@@ -112,10 +112,11 @@ impl Windowed {
         let batches: Vec<(usize, &[WindowIndex])> =
             windows.chunks(batch).enumerate().map(|(b, w)| (b * batch, w)).collect();
         let per_batch = self.engine.par_map(&batches, |&(first, ws)| {
+            let start = std::time::Instant::now();
             let outs = self.f.eval(ws);
             assert_eq!(outs.len(), ws.len(), "{} returned the wrong number of windows", self.name());
             self.evaluations.fetch_add(ws.len() as u64, Ordering::Relaxed);
-            self.engine.count_evaluations(ws.len());
+            self.engine.count_evaluations(self.id, ws.len(), start.elapsed().as_secs_f64());
             outs.into_iter()
                 .zip(ws)
                 .enumerate()

@@ -299,3 +299,40 @@ fn a_panicking_window_releases_its_claim() {
     // Had the claim leaked, this would wait forever.
     assert!(t.query(r).data.iter().all(|&v| (v - 1.0).abs() < 1e-6));
 }
+
+#[test]
+fn the_engine_counts_each_functions_windows_by_name() {
+    let engine = Engine::new(EngineConfig { cache_bytes: 64 << 20, threads: 2 });
+    let a = Windowed::new(&engine, Named("first", WindowLayout::square(8, 4, 0)));
+    let b = Windowed::new(&engine, Named("second", WindowLayout::square(16, 16, 0)));
+    a.query(Rect::new(0, 0, 8, 8));
+    b.query(Rect::new(0, 0, 40, 8));
+    // Cached windows are not evaluated again.
+    a.query(Rect::new(0, 0, 8, 8));
+    let stats = engine.function_stats();
+    let names: Vec<&str> = stats.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["first", "second"]);
+    assert_eq!(stats[0].windows, a.evaluations());
+    assert_eq!(stats[1].windows, b.evaluations());
+    assert_eq!(stats[1].windows, 3, "rows 0..40 of 16-row windows: three windows");
+    assert!(stats[0].windows >= 4 && stats.iter().all(|f| f.seconds >= 0.0), "{stats:?}");
+    assert_eq!(engine.stats().windows_evaluated, stats[0].windows + stats[1].windows);
+}
+
+/// A window function that returns zeros, under a name.
+struct Named(&'static str, WindowLayout);
+
+impl WindowFn for Named {
+    fn name(&self) -> &str {
+        self.0
+    }
+    fn channels(&self) -> usize {
+        1
+    }
+    fn layout(&self) -> WindowLayout {
+        self.1
+    }
+    fn eval(&self, windows: &[WindowIndex]) -> Vec<Tile> {
+        windows.iter().map(|&w| Tile::zeros(1, self.1.rect(w))).collect()
+    }
+}
