@@ -131,7 +131,11 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
         // Where a fresh area's time goes: the windows each stage and layer needed for it
         // (the learned core's are the costly ones).
         for f in rig.source.generator().pipeline().engine().function_stats() {
-            out.push(Measurement::new(&format!("  windows of {} it evaluated", f.name), "windows", vec![f.windows as f64]));
+            out.push(Measurement::new(
+                &format!("  windows of {} it evaluated", f.name),
+                "windows",
+                vec![f.windows as f64],
+            ));
         }
     }
     Ok(out)
