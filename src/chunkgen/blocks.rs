@@ -142,6 +142,27 @@ impl Chunk for Blocks {
     fn shrink_to_fit(&mut self) {}
 }
 
+/// Test support: panics, naming the first difference, unless `a` and `b` hold the same
+/// blocks and biomes (whatever their representation).
+#[cfg(test)]
+pub(crate) fn assert_same(a: &impl Chunk, b: &impl Chunk) {
+    assert_eq!(a.height(), b.height());
+    for y in 0..a.height() {
+        for z in 0..16 {
+            for x in 0..16 {
+                assert_eq!(a.block_state(x, y, z), b.block_state(x, y, z), "block {x} {y} {z}");
+            }
+        }
+    }
+    for y in 0..a.height() / 4 {
+        for z in 0..4 {
+            for x in 0..4 {
+                assert_eq!(a.biome(x, y, z), b.biome(x, y, z), "biome cell {x} {y} {z}");
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,22 +197,7 @@ mod tests {
     #[test]
     fn the_paletted_chunk_holds_every_block_and_biome() {
         let b = sample();
-        let chunk = b.to_chunk();
-        assert_eq!(chunk.height(), b.height());
-        for y in 0..b.height() {
-            for z in 0..16 {
-                for x in 0..16 {
-                    assert_eq!(chunk.block_state(x, y, z), b.block_state(x, y, z), "block {x}, {y}, {z}");
-                }
-            }
-        }
-        for y in 0..b.height() / 4 {
-            for z in 0..4 {
-                for x in 0..4 {
-                    assert_eq!(chunk.biome(x, y, z), b.biome(x, y, z), "cell {x}, {y}, {z}");
-                }
-            }
-        }
+        assert_same(&b.to_chunk(), &b);
     }
 
     #[test]

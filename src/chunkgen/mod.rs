@@ -47,6 +47,8 @@ use std::sync::Arc;
 use crate::config::Config;
 use crate::terrain::Pipeline;
 
+#[cfg(test)]
+pub(crate) use blocks::assert_same;
 pub use blocks::Blocks;
 pub use chunk::{PassTiming, CHUNK};
 pub use columns::Columns;

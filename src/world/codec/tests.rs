@@ -11,7 +11,7 @@ use valence::registry::RegistryIdx;
 use super::nbt::{bit_width, packed_len};
 use super::*;
 use crate::biome::BiomeRules;
-use crate::chunkgen::{BiomePalette, Generator, Light};
+use crate::chunkgen::{assert_same, BiomePalette, Generator, Light};
 use crate::config::Config;
 use crate::terrain::Pipeline;
 
@@ -87,24 +87,6 @@ fn decode_err(bytes: &[u8], x: i32, z: i32) -> String {
     match decoder().decode(x, z, bytes) {
         Ok(_) => panic!("damaged chunk decoded"),
         Err(e) => e.to_string(),
-    }
-}
-
-fn assert_same(a: &UnloadedChunk, b: &UnloadedChunk) {
-    assert_eq!(a.height(), b.height());
-    for y in 0..a.height() {
-        for z in 0..16 {
-            for x in 0..16 {
-                assert_eq!(a.block_state(x, y, z), b.block_state(x, y, z), "block {x} {y} {z}");
-            }
-        }
-    }
-    for y in 0..a.height() / 4 {
-        for z in 0..4 {
-            for x in 0..4 {
-                assert_eq!(a.biome(x, y, z), b.biome(x, y, z), "biome cell {x} {y} {z}");
-            }
-        }
     }
 }
 
