@@ -12,7 +12,7 @@
 use valence::nbt::Compound;
 use valence::prelude::{BiomeId, BlockState, Chunk, UnloadedChunk};
 
-use super::states::{States, SECTION_BLOCKS};
+use super::states::{index, States, SECTION_BLOCKS};
 
 /// Biome cells in a section (4 × 4 × 4).
 const SECTION_CELLS: usize = 64;
@@ -35,12 +35,6 @@ impl Blocks {
             states: vec![BlockState::AIR; height as usize * 256],
             biomes: vec![BiomeId::default(); height as usize / 4 * 16],
         }
-    }
-
-    #[inline]
-    fn index(x: u32, y: u32, z: u32) -> usize {
-        debug_assert!(x < 16 && z < 16, "block {x}, {y}, {z} is outside the chunk");
-        ((y * 16 + z) * 16 + x) as usize
     }
 
     #[inline]
@@ -97,12 +91,12 @@ impl Chunk for Blocks {
 
     #[inline]
     fn block_state(&self, x: u32, y: u32, z: u32) -> BlockState {
-        self.states[Blocks::index(x, y, z)]
+        self.states[index(x, y, z)]
     }
 
     #[inline]
     fn set_block_state(&mut self, x: u32, y: u32, z: u32, block: BlockState) -> BlockState {
-        std::mem::replace(&mut self.states[Blocks::index(x, y, z)], block)
+        std::mem::replace(&mut self.states[index(x, y, z)], block)
     }
 
     fn fill_block_state_section(&mut self, sect_y: u32, block: BlockState) {

@@ -17,7 +17,7 @@ use std::sync::OnceLock;
 
 use valence::prelude::{BlockState, ChunkPos, UnloadedChunk};
 
-use super::states::States;
+use super::states::{index, States};
 use valence::protocol::packets::play::LightUpdateS2c;
 use valence::protocol::{LengthPrefixedArray, VarInt};
 
@@ -41,12 +41,6 @@ enum Section {
 pub struct Light {
     sky: Vec<Section>,
     block: Vec<Section>,
-}
-
-/// Index of chunk-local block (`x`, `y`, `z`) in a chunk's levels.
-#[inline]
-fn index(x: u32, y: u32, z: u32) -> usize {
-    ((y * 16 + z) * 16 + x) as usize
 }
 
 impl Light {

@@ -10,6 +10,14 @@ use valence::prelude::{Chunk, UnloadedChunk};
 /// Blocks in a section.
 pub const SECTION_BLOCKS: usize = 4096;
 
+/// Index of chunk-local block (`x`, `y`, `z`) in a chunk's flat arrays, section order
+/// (`(y·16 + z)·16 + x`): [`States`], light levels and the generator's `Blocks`.
+#[inline]
+pub fn index(x: u32, y: u32, z: u32) -> usize {
+    debug_assert!(x < 16 && z < 16, "block {x}, {y}, {z} is outside the chunk");
+    ((y * 16 + z) * 16 + x) as usize
+}
+
 /// Raw block-state ids of every block of a chunk, index `(y·16 + z)·16 + x` (the order of a
 /// section's blocks in the protocol and in region files).
 pub struct States {

@@ -15,7 +15,7 @@
 
 use std::collections::HashSet;
 use std::num::NonZeroUsize;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 
 use lru::LruCache;
@@ -96,9 +96,7 @@ pub struct Engine {
     settled: Condvar,
     limit: usize,
     threads: usize,
-    next_id: AtomicU32,
-    evaluated: AtomicU64,
-    /// Per registered tensor (index: its id).
+    /// Per registered tensor (index: its id); every count of windows evaluated comes from here.
     functions: Mutex<Vec<FunctionStats>>,
 }
 
@@ -117,8 +115,6 @@ impl Engine {
             settled: Condvar::new(),
             limit: config.cache_bytes,
             threads: config.threads.max(1),
-            next_id: AtomicU32::new(0),
-            evaluated: AtomicU64::new(0),
             functions: Mutex::new(Vec::new()),
         })
     }
@@ -137,7 +133,7 @@ impl Engine {
     pub fn stats(&self) -> EngineStats {
         let s = self.lock();
         EngineStats {
-            windows_evaluated: self.evaluated.load(Ordering::Relaxed),
+            windows_evaluated: self.functions().iter().map(|f| f.windows).sum(),
             cache_hits: s.hits,
             evictions: s.evictions,
             cache_bytes: s.bytes,
@@ -156,7 +152,7 @@ impl Engine {
     /// What each window function has evaluated so far and how long it took, one entry per
     /// name, in the order they were first registered (where a query's time goes).
     pub fn function_stats(&self) -> Vec<FunctionStats> {
-        let functions = self.functions.lock().unwrap_or_else(|e| e.into_inner());
+        let functions = self.functions();
         let mut out: Vec<FunctionStats> = Vec::new();
         for f in functions.iter() {
             match out.iter_mut().find(|o| o.name == f.name) {
@@ -170,19 +166,26 @@ impl Engine {
         out
     }
 
+    /// Windows tensor `id` has evaluated.
+    pub(crate) fn evaluations_of(&self, id: u32) -> u64 {
+        self.functions().get(id as usize).map_or(0, |f| f.windows)
+    }
+
+    fn functions(&self) -> MutexGuard<'_, Vec<FunctionStats>> {
+        // Counters only: a panic mid-update leaves them consistent enough to keep.
+        self.functions.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     pub(crate) fn register(&self, name: &str) -> u32 {
-        let mut functions = self.functions.lock().unwrap_or_else(|e| e.into_inner());
-        let id = self.next_id.fetch_add(1, Ordering::Relaxed);
-        debug_assert_eq!(id as usize, functions.len());
+        let mut functions = self.functions();
+        let id = functions.len() as u32;
         functions.push(FunctionStats { name: name.to_string(), windows: 0, seconds: 0.0 });
         id
     }
 
     /// Tensor `id` evaluated `n` windows in `seconds`.
     pub(crate) fn count_evaluations(&self, id: u32, n: usize, seconds: f64) {
-        self.evaluated.fetch_add(n as u64, Ordering::Relaxed);
-        let mut functions = self.functions.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(f) = functions.get_mut(id as usize) {
+        if let Some(f) = self.functions().get_mut(id as usize) {
             f.windows += n as u64;
             f.seconds += seconds;
         }

@@ -1,6 +1,6 @@
 //! A windowed infinite tensor: the InfiniteDiffusion update for one step of one stage.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use super::engine::{Engine, Lookup, WindowKey};
@@ -37,7 +37,6 @@ pub struct Windowed {
     weight_y: Vec<f32>,
     weight_x: Vec<f32>,
     engine: Arc<Engine>,
-    evaluations: AtomicU64,
 }
 
 impl Windowed {
@@ -55,13 +54,12 @@ impl Windowed {
             layout,
             f: Box::new(f),
             engine: engine.clone(),
-            evaluations: AtomicU64::new(0),
         })
     }
 
     /// Windows of this tensor evaluated so far.
     pub fn evaluations(&self) -> u64 {
-        self.evaluations.load(Ordering::Relaxed)
+        self.engine.evaluations_of(self.id)
     }
 
     /// The window layout.
@@ -115,7 +113,6 @@ impl Windowed {
             let start = std::time::Instant::now();
             let outs = self.f.eval(ws);
             assert_eq!(outs.len(), ws.len(), "{} returned the wrong number of windows", self.name());
-            self.evaluations.fetch_add(ws.len() as u64, Ordering::Relaxed);
             self.engine.count_evaluations(self.id, ws.len(), start.elapsed().as_secs_f64());
             outs.into_iter()
                 .zip(ws)
