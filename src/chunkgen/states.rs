@@ -5,7 +5,7 @@
 //! a section lookup and a nibble unpacking each); reading every block twice, once for light
 //! and once for the encoder, was a tenth of pre-generation's time.
 
-use valence::prelude::{Chunk, UnloadedChunk};
+use valence::prelude::Chunk;
 
 /// Blocks in a section.
 pub const SECTION_BLOCKS: usize = 4096;
@@ -27,7 +27,7 @@ pub struct States {
 
 impl States {
     /// Reads every block of `chunk`.
-    pub fn of(chunk: &UnloadedChunk) -> States {
+    pub fn of(chunk: &impl Chunk) -> States {
         let height = chunk.height();
         let mut ids = Vec::with_capacity(height as usize * 256);
         for y in 0..height {
@@ -66,7 +66,7 @@ impl States {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use valence::prelude::BlockState;
+    use valence::prelude::{BlockState, UnloadedChunk};
 
     #[test]
     fn every_block_is_read_in_section_order() {

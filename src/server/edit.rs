@@ -1,8 +1,8 @@
 //! Players' block edits: breaking and placing blocks. An edit changes the chunk every player
-//! who sees it is shown (valence sends the block update to the chunk's viewers), its sky light
-//! is computed again and resent, and the chunk is saved over its generated copy — a saved
-//! chunk is always loaded rather than generated, so the edit survives unloading, reconnects
-//! and restarts (unless `world.save_chunks` is off, when edits live only while the chunk is
+//! who sees it is shown (valence sends the block update to the chunk's viewers), its light and
+//! its neighbours' are computed again and resent, and the chunk is saved over its generated
+//! copy — a saved chunk is always loaded rather than generated, so the edit survives
+//! unloading, reconnects and restarts (unless `world.save_chunks` is off, when edits live only while the chunk is
 //! in memory).
 //!
 //! Creative players break a block at the first hit; survival players when their client has
@@ -17,7 +17,6 @@ use std::sync::Arc;
 use valence::interact_block::InteractBlockEvent;
 use valence::inventory::HeldItem;
 use valence::prelude::*;
-use valence::protocol::{CompressionThreshold, PacketEncoder};
 
 use super::dimension::{Palette, WorldSetup};
 use super::drops;
@@ -35,7 +34,6 @@ struct Edited(HashSet<ChunkPos>);
 struct Saver {
     store: Option<Arc<Store>>,
     encoder: Encoder,
-    compression: CompressionThreshold,
 }
 
 /// Adds the editing systems.
@@ -46,12 +44,11 @@ pub fn build(app: &mut App) {
     drops::build(app);
 }
 
-fn make_saver(mut commands: Commands, setup: Res<WorldSetup>, palette: Res<Palette>, server: Res<Server>) {
+fn make_saver(mut commands: Commands, setup: Res<WorldSetup>, palette: Res<Palette>) {
     let v = setup.generator.vertical();
     commands.insert_resource(Saver {
         store: setup.store.clone(),
         encoder: Encoder::new(v.min_y, palette.0.names().to_vec()),
-        compression: server.compression_threshold(),
     });
 }
 
@@ -120,7 +117,8 @@ fn place(
     }
 }
 
-/// Relights and saves every chunk edited this tick.
+/// Relights and saves every chunk edited this tick. All of them are relit together, so a
+/// chunk beside two edited ones is joined with both edits.
 fn save_edited(
     layers: Query<&ChunkLayer>,
     mut edited: ResMut<Edited>,
@@ -132,52 +130,35 @@ fn save_edited(
         return;
     }
     let (Ok(layer), Some(mut saver), Some(mut streamer)) = (layers.get_single(), saver, streamer) else { return };
+    let mut chunks = Vec::new();
     for pos in edited.0.drain() {
-        let Some(loaded) = layer.chunk(pos) else { continue };
-        let chunk = snapshot(loaded);
-        let states = States::of(&chunk);
-        let light = Light::of_states(&states);
-        let mut encoder = PacketEncoder::new();
-        encoder.set_compression(saver.compression);
-        match encoder.append_packet(&light.packet(pos)) {
-            Ok(()) => {
-                streamer.relight(pos, Arc::from(&encoder.take()[..]));
+        if let Some(chunk) = layer.chunk(pos) {
+            let states = States::of(chunk);
+            let light = Light::of_states(&states);
+            chunks.push((pos, chunk, states, light));
+        }
+    }
+    let owns = chunks.iter().map(|(pos, _, _, light)| (*pos, light.clone())).collect();
+    let lights = match streamer.relight(owns) {
+        Ok((lights, changed)) => {
+            for pos in changed {
                 for mut s in &mut sent {
                     s.forget(pos);
                 }
             }
-            Err(e) => tracing::error!("light of edited chunk {}, {}: {e}", pos.x, pos.z),
+            lights
         }
-        if let Some(store) = saver.store.clone() {
-            let nbt = saver.encoder.encode_states(pos.x, pos.z, &chunk, &states, &light);
-            if let Err(e) = store.save(pos.x, pos.z, &nbt) {
-                tracing::error!("saving edited chunk {}, {}: {e}", pos.x, pos.z);
-                say!("could not save the edit to chunk {}, {}: {e}", pos.x, pos.z);
-            }
+        Err(e) => {
+            tracing::error!("light of edited chunks: {e:#}");
+            chunks.iter().map(|(_, _, _, light)| Arc::new(light.clone())).collect()
         }
-    }
-}
-
-/// A copy of a loaded chunk's blocks and biomes, to light and encode.
-fn snapshot(chunk: &impl Chunk) -> UnloadedChunk {
-    let height = chunk.height();
-    let mut out = UnloadedChunk::with_height(height);
-    for y in 0..height {
-        for z in 0..16 {
-            for x in 0..16 {
-                let b = chunk.block_state(x, y, z);
-                if !b.is_air() {
-                    out.set_block_state(x, y, z, b);
-                }
-            }
+    };
+    let Some(store) = saver.store.clone() else { return };
+    for ((pos, chunk, states, _), light) in chunks.iter().zip(lights) {
+        let nbt = saver.encoder.encode_states(pos.x, pos.z, *chunk, states, &light);
+        if let Err(e) = store.save(pos.x, pos.z, &nbt) {
+            tracing::error!("saving edited chunk {}, {}: {e}", pos.x, pos.z);
+            say!("could not save the edit to chunk {}, {}: {e}", pos.x, pos.z);
         }
     }
-    for y in 0..height / 4 {
-        for z in 0..4 {
-            for x in 0..4 {
-                out.set_biome(x, y, z, chunk.biome(x, y, z));
-            }
-        }
-    }
-    out
 }

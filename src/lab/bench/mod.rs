@@ -8,6 +8,7 @@
 
 mod chart;
 mod engine;
+mod light;
 mod pipeline;
 mod pregen;
 

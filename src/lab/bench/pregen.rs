@@ -113,6 +113,7 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     let spawn = crate::world::find_spawn(generator, &rules).block;
     let land = Task { center_x: i64::from(spawn.x), center_z: i64::from(spawn.z), radius: 160, shape: Shape::Square };
     out.extend(per_chunk(generator, &rules, land, "per chunk on land by the spawn, 1 thread", false));
+    out.extend(super::light::measure(generator, &rules, (spawn.x, spawn.z), "light on land by the spawn, 1 thread"));
 
     if chunks > 0 {
         // Throughput and memory of a long run: a square of about `chunks` chunks.

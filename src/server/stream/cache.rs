@@ -33,6 +33,13 @@ impl ChunkCache {
         self.0.as_ref().map_or(0, LruCache::len)
     }
 
+    /// Drops the chunk at `pos`, if held.
+    pub fn drop_chunk(&mut self, pos: ChunkPos) {
+        if let Some(cache) = &mut self.0 {
+            cache.pop(&pos);
+        }
+    }
+
     /// Drops everything.
     pub fn clear(&mut self) {
         if let Some(cache) = &mut self.0 {
@@ -43,14 +50,16 @@ impl ChunkCache {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::Arc;
-
     use valence::prelude::UnloadedChunk;
+    use valence::protocol::CompressionThreshold;
 
+    use super::super::light::Lit;
     use super::*;
+    use crate::chunkgen::Light;
 
     fn built() -> Built {
-        Built { chunk: UnloadedChunk::new(), light: Arc::from(&[][..]) }
+        let (chunk, pos) = (UnloadedChunk::with_height(16), ChunkPos::new(0, 0));
+        Built { lit: Lit::alone(pos, Light::of(&chunk), CompressionThreshold::default()).expect("encodes"), chunk }
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! valence's viewer counts, which underflow when clients leave (valence issue #716).
 
 mod cache;
+mod light;
 #[cfg(test)]
 mod tests;
 mod workers;
@@ -19,13 +20,15 @@ use std::time::{Duration, Instant};
 use valence::app::AppExit;
 use valence::client::{FlushPacketsSet, UpdateClientsSet};
 use valence::prelude::*;
-use valence::protocol::WritePacket;
+use valence::protocol::{CompressionThreshold, WritePacket};
 
 use self::cache::ChunkCache;
+use self::light::Lit;
 use self::workers::{Built, Finished, Results, Workers};
 use super::dimension::{Palette, WorldSetup};
 use super::players::PlayersSet;
 use crate::biome::BiomeRules;
+use crate::chunkgen::Light;
 use crate::pregen::Job;
 use crate::world::ChunkSource;
 
@@ -41,8 +44,10 @@ pub struct Streamer {
     /// Chunks whose building panicked: not retried until the rules change.
     failed: HashSet<ChunkPos>,
     /// Every loaded chunk: the rules generation it was built with (only current ones are
-    /// cached when unloaded) and its light packet.
+    /// cached when unloaded) and its light.
     loaded: HashMap<ChunkPos, Loaded>,
+    /// How light packets are compressed (as valence compresses everything else).
+    compression: CompressionThreshold,
     last_views: Vec<ChunkView>,
     /// Something changed that may change the wish list.
     dirty: bool,
@@ -51,7 +56,7 @@ pub struct Streamer {
 
 struct Loaded {
     generation: u64,
-    light: Arc<[u8]>,
+    lit: Lit,
 }
 
 /// Chunks whose light this client has been sent (valence sends chunks without light).
@@ -127,11 +132,71 @@ impl Streamer {
         self.workers.set_pregen(job);
     }
 
-    /// The light packet of loaded chunk `pos` is now `light` (a player edited the chunk).
-    pub fn relight(&mut self, pos: ChunkPos, light: Arc<[u8]>) {
-        if let Some(loaded) = self.loaded.get_mut(&pos) {
-            loaded.light = light;
+    /// Loaded chunks now have these `own` lights (players edited them): their light and
+    /// their neighbours' are joined again where they can be. Returns their lights in the same
+    /// order (joined when all their neighbours are loaded) and the chunks whose light packet
+    /// clients must get again.
+    pub fn relight(&mut self, owns: Vec<(ChunkPos, Light)>) -> anyhow::Result<(Vec<Arc<Light>>, Vec<ChunkPos>)> {
+        let mut lights = Vec::with_capacity(owns.len());
+        let mut around = HashSet::new();
+        for (pos, own) in owns {
+            let Some(loaded) = self.loaded.get_mut(&pos) else {
+                lights.push((pos, Arc::new(own)));
+                continue;
+            };
+            loaded.lit = Lit::alone(pos, own, self.compression)?;
+            lights.push((pos, loaded.lit.own.clone()));
+            around.extend(light::area(pos));
         }
+        for &p in &around {
+            match self.loaded.get_mut(&p) {
+                Some(loaded) => loaded.lit.unjoin(),
+                // Joined with the blocks before the edit.
+                None => self.cache.drop_chunk(p),
+            }
+        }
+        let mut joined = HashMap::new();
+        for &p in &around {
+            if let Some(light) = self.join(p)? {
+                joined.insert(p, Arc::new(light));
+            }
+        }
+        let lights = lights.into_iter().map(|(pos, own)| joined.get(&pos).cloned().unwrap_or(own)).collect();
+        Ok((lights, around.into_iter().filter(|p| self.loaded.contains_key(p)).collect()))
+    }
+
+    /// Joins the light of loaded chunk `pos` with its neighbours' if it is not joined yet
+    /// and they are all loaded. Returns the joined light when that let light in (its packet
+    /// changed).
+    fn join(&mut self, pos: ChunkPos) -> anyhow::Result<Option<Light>> {
+        let area = light::area(pos);
+        let lights: Vec<&Arc<Light>> = area.iter().filter_map(|p| self.loaded.get(p)).map(|l| &l.lit.own).collect();
+        if lights.len() < 9 || self.loaded[&pos].lit.is_joined() {
+            return Ok(None);
+        }
+        let joined = Light::joined(std::array::from_fn(|i| &**lights[i]));
+        let compression = self.compression;
+        if let Some(loaded) = self.loaded.get_mut(&pos) {
+            loaded.lit.set_joined(pos, joined.as_ref(), compression)?;
+        }
+        Ok(joined)
+    }
+
+    /// Joins the light of every chunk around the chunks `inserted` that can be joined now;
+    /// returns those whose light packet changed.
+    fn join_around(&mut self, inserted: &[ChunkPos]) -> Vec<ChunkPos> {
+        let mut around: Vec<ChunkPos> = inserted.iter().flat_map(|&p| light::area(p)).collect();
+        around.sort_unstable_by_key(|p| (p.x, p.z));
+        around.dedup();
+        let mut changed = Vec::new();
+        for pos in around {
+            match self.join(pos) {
+                Ok(Some(_)) => changed.push(pos),
+                Ok(None) => {}
+                Err(e) => tracing::error!("joined light of chunk {}, {}: {e:#}", pos.x, pos.z),
+            }
+        }
+        changed
     }
 
     /// Wakes idle workers from any thread (a pre-generation task resumed).
@@ -164,14 +229,16 @@ fn start_workers(
 ) {
     let (done, results) = mpsc::channel();
     let threads = setup.config.server.chunk_threads as usize;
+    let compression = server.compression_threshold();
     let source = Arc::new(ChunkSource::new(setup.generator.clone(), palette.0.clone(), setup.store.clone()));
-    match Workers::start(threads, source, setup.rules.clone(), server.compression_threshold(), done) {
+    match Workers::start(threads, source, setup.rules.clone(), compression, done) {
         Ok(workers) => commands.insert_resource(Streamer {
             workers,
             results: Results::new(results),
             cache: ChunkCache::new(setup.config.server.chunk_cache as usize),
             failed: HashSet::new(),
             loaded: HashMap::new(),
+            compression,
             last_views: Vec::new(),
             dirty: true,
             stats: Stats::default(),
@@ -183,11 +250,13 @@ fn start_workers(
     }
 }
 
-/// Once per tick: take in finished chunks, unload what no view holds, and hand the workers
-/// a fresh nearest-first wish list when anything changed. Never waits on a worker.
+/// Once per tick: take in finished chunks, join the light of those whose neighbours are all
+/// loaded now, unload what no view holds, and hand the workers a fresh nearest-first wish
+/// list when anything changed. Never waits on a worker.
 fn stream_chunks(
     mut layers: Query<&mut ChunkLayer>,
     clients: Query<View, (With<Client>, Without<Despawned>)>,
+    mut sent: Query<&mut LightSent>,
     streamer: Option<ResMut<Streamer>>,
 ) {
     let (Some(mut streamer), Ok(mut layer)) = (streamer, layers.get_single_mut()) else {
@@ -197,6 +266,7 @@ fn stream_chunks(
     let views: Vec<ChunkView> = clients.iter().map(|v| v.get()).collect();
     let wanted = |pos: ChunkPos| views.iter().any(|v| v.contains(pos));
     let generation = s.workers.generation();
+    let mut inserted = Vec::new();
 
     for Finished { pos, built, generation: built_with, elapsed } in s.results.drain() {
         s.workers.finished(pos);
@@ -211,7 +281,8 @@ fn stream_chunks(
         s.stats.recent.push_back(Instant::now());
         if wanted(pos) && layer.chunk(pos).is_none() {
             layer.insert_chunk(pos, built.chunk);
-            s.loaded.insert(pos, Loaded { generation: built_with, light: built.light });
+            s.loaded.insert(pos, Loaded { generation: built_with, lit: built.lit });
+            inserted.push(pos);
         } else if built_with == generation {
             s.cache.put(pos, built);
         }
@@ -225,7 +296,7 @@ fn stream_chunks(
             let loaded = s.loaded.remove(&pos);
             if let (Some(chunk), Some(loaded)) = (layer.remove_chunk(pos), loaded) {
                 if loaded.generation == generation {
-                    s.cache.put(pos, Built { chunk, light: loaded.light });
+                    s.cache.put(pos, Built { chunk, lit: loaded.lit });
                 }
             }
         }
@@ -242,7 +313,8 @@ fn stream_chunks(
                 }
                 if let Some(built) = s.cache.take(pos) {
                     layer.insert_chunk(pos, built.chunk);
-                    s.loaded.insert(pos, Loaded { generation, light: built.light });
+                    s.loaded.insert(pos, Loaded { generation, lit: built.lit });
+                    inserted.push(pos);
                     continue;
                 }
                 let d = view.pos.distance_squared(pos);
@@ -252,6 +324,12 @@ fn stream_chunks(
         let mut list: Vec<(u64, ChunkPos)> = nearest.into_iter().map(|(pos, d)| (d, pos)).collect();
         list.sort_unstable_by_key(|&(d, pos)| (d, pos.x, pos.z));
         s.workers.set_wanted(list.into_iter().map(|(_, pos)| pos));
+    }
+
+    for pos in s.join_around(&inserted) {
+        for mut sent in &mut sent {
+            sent.forget(pos);
+        }
     }
 }
 
@@ -274,7 +352,7 @@ fn send_light(mut clients: Query<(&mut Client, View, &mut LightSent)>, streamer:
         for pos in view.iter() {
             if !sent.0.contains(&pos) {
                 if let Some(loaded) = streamer.loaded.get(&pos) {
-                    client.write_packet_bytes(&loaded.light);
+                    client.write_packet_bytes(loaded.lit.packet());
                     sent.0.insert(pos);
                 }
             }

@@ -3,7 +3,7 @@
 //!
 //! Every wait runs ticks until a condition holds, bounded by a timeout.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::net::{IpAddr, Ipv4Addr};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -16,9 +16,10 @@ use valence::prelude::*;
 use valence::protocol::bytes::BytesMut;
 use valence::protocol::PacketEncoder;
 
+use super::light::Lit;
 use super::Streamer;
 use crate::biome::BiomeRules;
-use crate::chunkgen::Generator;
+use crate::chunkgen::{Generator, Light, States};
 use crate::config::Config;
 use crate::server::dimension::{self, WorldSetup};
 use crate::terrain::Pipeline;
@@ -167,4 +168,89 @@ fn a_client_disconnecting_unloads_the_chunks_only_it_saw() {
     assert_eq!(status.loaded, 0, "{status:?}");
     assert_eq!(status.queued, 0, "{status:?}");
     assert!(status.cached <= CACHE as usize, "{status:?}");
+}
+
+#[test]
+fn chunks_whose_neighbours_are_all_loaded_are_sent_their_joined_light() {
+    let (mut app, layer) = app();
+    join(&mut app, layer, "looker", 8.0, 8.0);
+    let view = view_of(8.0, 8.0);
+    tick_until(&mut app, "the view", |app| in_layer(app, layer) == view);
+    let setup = app.world.resource::<WorldSetup>();
+    let palette = app.world.resource::<dimension::Palette>().0.clone();
+    let own = |p: ChunkPos| Light::of_states(&setup.generator.blocks(&setup.rules, &palette, p.x, p.z).states());
+    let streamer = app.world.resource::<Streamer>();
+    let (mut inner, mut brighter) = (0, 0);
+    for &pos in &view {
+        let lit = &streamer.loaded[&pos].lit;
+        assert_eq!(*lit.own, own(pos), "chunk {pos:?}'s own light");
+        let area = super::light::area(pos);
+        if !area.iter().all(|p| view.contains(p)) {
+            assert!(!lit.is_joined(), "chunk {pos:?} on the view's edge cannot be joined");
+            continue;
+        }
+        inner += 1;
+        assert!(lit.is_joined(), "chunk {pos:?} has every neighbour loaded");
+        // What a client gets is the light of the nine chunks built here, joined.
+        let lights = area.map(own);
+        let want = Light::joined(std::array::from_fn(|i| &lights[i])).unwrap_or_else(|| lights[4].clone());
+        brighter += usize::from(want != lights[4]);
+        let expected = Lit::alone(pos, want, streamer.compression).expect("encodes");
+        assert_eq!(lit.packet(), expected.packet(), "chunk {pos:?}'s light packet");
+    }
+    assert!(inner > 0, "some chunk of the view has all its neighbours in it");
+    assert!(brighter > 0, "here, light crosses some border ({inner} chunks joined)");
+}
+
+#[test]
+fn an_edit_relights_the_chunks_around_it_as_their_blocks_now_are() {
+    let (mut app, layer) = app();
+    join(&mut app, layer, "digger", 8.0, 8.0);
+    let view = view_of(8.0, 8.0);
+    tick_until(&mut app, "the view", |app| in_layer(app, layer) == view);
+    let v = *app.world.resource::<WorldSetup>().generator.vertical();
+    // A shaft from the sky down the east edge of chunk 0, 0 (x 15, z 8) to 20 blocks under
+    // the ground, and a tunnel from its foot east into chunk 1, 0: a player's digging.
+    let mut chunks = app.world.get_mut::<ChunkLayer>(layer).expect("layer");
+    let top = v.min_y + v.height - 1;
+    let ground =
+        (v.min_y..=top).rev().find(|&y| chunks.block([15, y, 8]).is_some_and(|b| !b.state.is_air())).expect("ground");
+    let foot = ground - 20;
+    for y in foot..=top {
+        chunks.set_block([15, y, 8], BlockState::AIR);
+    }
+    for x in 16..20 {
+        chunks.set_block([x, foot, 8], BlockState::AIR);
+    }
+    let own = |chunks: &ChunkLayer, p: ChunkPos| Light::of_states(&States::of(chunks.chunk(p).expect("loaded")));
+    let (a, b) = (ChunkPos::new(0, 0), ChunkPos::new(1, 0));
+    let (own_a, own_b) = (own(&chunks, a), own(&chunks, b));
+    let mut lights: HashMap<ChunkPos, Light> = HashMap::new();
+    for p in view.iter().copied() {
+        lights.insert(p, own(&chunks, p));
+    }
+    let mut streamer = app.world.resource_mut::<Streamer>();
+    let (relit, changed) = streamer.relight(vec![(a, own_a), (b, own_b)]).expect("relit");
+    let changed: HashSet<ChunkPos> = changed.into_iter().collect();
+    let around: HashSet<ChunkPos> = super::light::area(a).into_iter().chain(super::light::area(b)).collect();
+    assert_eq!(changed, around, "the light of the edited chunks and their neighbours is sent again");
+    for &pos in &around {
+        let area = super::light::area(pos);
+        if !area.iter().all(|p| view.contains(p)) {
+            continue;
+        }
+        let nine = area.map(|p| &lights[&p]);
+        let want = Light::joined(nine).unwrap_or_else(|| lights[&pos].clone());
+        if pos == b {
+            let y = (foot - v.min_y) as u32;
+            assert_eq!(
+                (want.sky(0, y, 8), lights[&b].sky(0, y, 8)),
+                (14, 0),
+                "the tunnel is lit from the shaft next door"
+            );
+            assert_eq!(*relit[1], want, "the light saved with the edit is the joined light");
+        }
+        let lit = &streamer.loaded[&pos].lit;
+        assert_eq!(lit.packet(), Lit::alone(pos, want, streamer.compression).expect("encodes").packet(), "{pos:?}");
+    }
 }

@@ -15,18 +15,19 @@ use std::thread::{self, JoinHandle};
 use std::time::{Duration, Instant};
 
 use valence::prelude::{ChunkPos, UnloadedChunk};
-use valence::protocol::{CompressionThreshold, PacketEncoder};
+use valence::protocol::CompressionThreshold;
 
+use super::light::Lit;
 use crate::biome::BiomeRules;
 use crate::pregen::{self, Job};
 use crate::world::{ChunkSource, Origin, Scratch};
 
-/// A chunk ready to insert, with its sky light as a ready-to-send packet.
+/// A chunk ready to insert, with its light.
 pub struct Built {
     /// The blocks and biomes.
     pub chunk: UnloadedChunk,
-    /// The encoded (and, above the threshold, compressed) `LightUpdateS2c` for it.
-    pub light: Arc<[u8]>,
+    /// Its light, with the packet for it ready to send.
+    pub lit: Lit,
 }
 
 /// A chunk a worker finished (or failed to build).
@@ -219,8 +220,8 @@ fn work(shared: &Shared, source: &ChunkSource, compression: CompressionThreshold
     }
 }
 
-/// Loads or builds one chunk and encodes its light packet the way valence encodes everything
-/// else. An unreadable saved chunk is reported on the console and regenerated.
+/// Loads or builds one chunk and encodes its light packet. An unreadable saved chunk is
+/// reported on the console and regenerated.
 fn build(
     source: &ChunkSource,
     scratch: &mut Scratch,
@@ -232,10 +233,7 @@ fn build(
     if let Origin::Regenerated(reason) = origin {
         say!("corrupt chunk {}, {}: {reason}; regenerated it", pos.x, pos.z);
     }
-    let mut encoder = PacketEncoder::new();
-    encoder.set_compression(compression);
-    encoder.append_packet(&light.packet(pos))?;
-    Ok(Built { chunk, light: Arc::from(&encoder.take()[..]) })
+    Ok(Built { chunk, lit: Lit::alone(pos, light, compression)? })
 }
 
 /// The receiving end, wrapped so a Bevy resource (which must be `Sync`) can own it.

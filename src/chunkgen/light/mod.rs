@@ -7,15 +7,17 @@
 //! mouth, the space under an overhang — vanilla's flood fill. Block light spreads the same
 //! way from what glows: lava, at 15.
 //!
-//! Light stays inside its chunk: a neighbouring chunk's lava or open cave mouth lights
-//! nothing across the border (vanilla's engine, which holds all loaded chunks, does). Lava
-//! lies deep in caves and terrain is mostly a height field, so such borders are rare; a
-//! client that changes a block near one relights it itself.
+//! [`Light::of`] lights a chunk alone, as if walled in at its borders. [`Light::joined`]
+//! then lets the light of its eight neighbours in (a neighbour's lava, an open cave mouth or
+//! an overhang across the border), exactly as a flood fill over all nine would: the server
+//! sends a chunk's joined light once its neighbours are loaded (see `joined.rs`).
 
 use std::collections::VecDeque;
 use std::sync::OnceLock;
 
 use valence::prelude::{BlockState, ChunkPos, UnloadedChunk};
+
+mod joined;
 
 use super::states::{index, States};
 use valence::protocol::packets::play::LightUpdateS2c;
@@ -36,11 +38,13 @@ enum Section {
 }
 
 /// Light of one chunk, sky and block: one entry per section, plus one below the world and
-/// one above it, as the protocol counts them.
+/// one above it, as the protocol counts them. It keeps the chunk's opacity (each block's
+/// dampening) beside the light, which is what its neighbours' [`Light::joined`] reads.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
     sky: Vec<Section>,
     block: Vec<Section>,
+    opacity: Vec<Section>,
 }
 
 impl Light {
@@ -108,7 +112,12 @@ impl Light {
         }
         spread(&mut sky, &damp, &mut queue, height);
         spread(&mut block, &damp, &mut glowing, height);
-        Light { sky: sections(&sky, height, Section::Full), block: sections(&block, height, Section::Dark) }
+        Light {
+            sky: sections(&sky, height, Section::Full),
+            block: sections(&block, height, Section::Dark),
+            // Below the world is as opaque as bedrock, above it open air.
+            opacity: sections_between(Section::Full, &damp, height, Section::Dark),
+        }
     }
 
     /// Sky light at chunk-local block (`x`, `y`, `z`) with `y` counted from the world's floor.
@@ -159,9 +168,14 @@ impl Light {
 /// The sections of a chunk's `levels`, with one below the world (dark: bedrock above it) and
 /// one above it (`above`: the open sky's, or no block light).
 fn sections(levels: &[u8], height: u32, above: Section) -> Vec<Section> {
+    sections_between(Section::Dark, levels, height, above)
+}
+
+/// The sections of a chunk's `levels`, with `below` and `above` the world.
+fn sections_between(below: Section, levels: &[u8], height: u32, above: Section) -> Vec<Section> {
     let world_sections = (height / 16) as usize;
     let mut out = Vec::with_capacity(world_sections + 2);
-    out.push(Section::Dark);
+    out.push(below);
     out.extend((0..world_sections).map(|s| Section::from_levels(&levels[s * 4096..(s + 1) * 4096])));
     out.push(above);
     out
@@ -240,6 +254,19 @@ impl Section {
                 let i = index(x, y % 16, z);
                 (bytes[i / 2] >> ((i % 2) * 4)) & 0xF
             }
+        }
+    }
+
+    /// Sets the value at (`x`, `y % 16`, `z`) to `level`.
+    fn set(&mut self, x: u32, y: u32, z: u32, level: u8) {
+        if let Section::Dark | Section::Full = self {
+            let fill = if *self == Section::Full { 0xFF } else { 0 };
+            *self = Section::Mixed(Box::new([fill; SECTION_BYTES]));
+        }
+        if let Section::Mixed(bytes) = self {
+            let i = index(x, y % 16, z);
+            let shift = (i % 2) * 4;
+            bytes[i / 2] = (bytes[i / 2] & !(0xF << shift)) | (level << shift);
         }
     }
 
