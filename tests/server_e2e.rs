@@ -399,7 +399,8 @@ fn edit_block(world: &Path, generator: &Generator, chunk: (i32, i32), at: (i64, 
         Decoder::new(v.min_y, v.height as u32, palette.clone()).decode(chunk.0, chunk.1, &nbt).expect("decode");
     let (bx, bz) = (at.0.rem_euclid(16) as u32, at.1.rem_euclid(16) as u32);
     blocks.set_block_state(bx, (y - v.min_y) as u32, bz, block);
-    let nbt = Encoder::new(v.min_y, palette.names().to_vec()).encode(chunk.0, chunk.1, &blocks, &Light::of(&blocks));
+    let nbt =
+        Encoder::new(v.min_y, palette.names().to_vec()).encode(chunk.0, chunk.1, &blocks, Some(&Light::of(&blocks)));
     file.write(lx, lz, &compress(&nbt), 0).expect("write");
     file.sync().expect("sync");
 }

@@ -20,7 +20,7 @@ use valence::prelude::*;
 
 use super::dimension::{Palette, WorldSetup};
 use super::drops;
-use super::stream::Streamer;
+use super::stream::{Relit, Streamer};
 use crate::chunkgen::{Light, States};
 use crate::world::codec::Encoder;
 use crate::world::Store;
@@ -140,7 +140,7 @@ fn save_edited(
     }
     let owns = chunks.iter().map(|(pos, _, _, light)| (*pos, light.clone())).collect();
     let lights = match streamer.relight(owns) {
-        Ok((lights, changed)) => {
+        Ok(Relit { lights, changed }) => {
             for pos in changed {
                 for mut s in &mut sent {
                     s.forget(pos);
@@ -150,12 +150,12 @@ fn save_edited(
         }
         Err(e) => {
             tracing::error!("light of edited chunks: {e:#}");
-            chunks.iter().map(|(_, _, _, light)| Arc::new(light.clone())).collect()
+            vec![None; chunks.len()]
         }
     };
     let Some(store) = saver.store.clone() else { return };
     for ((pos, chunk, states, _), light) in chunks.iter().zip(lights) {
-        let nbt = saver.encoder.encode_states(pos.x, pos.z, *chunk, states, &light);
+        let nbt = saver.encoder.encode_states(pos.x, pos.z, *chunk, states, light.as_deref());
         if let Err(e) = store.save(pos.x, pos.z, &nbt) {
             tracing::error!("saving edited chunk {}, {}: {e}", pos.x, pos.z);
             say!("could not save the edit to chunk {}, {}: {e}", pos.x, pos.z);

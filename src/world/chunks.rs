@@ -60,10 +60,11 @@ impl ChunkSource {
         }
     }
 
-    /// The chunk at (`x`, `z`) and its sky light: from disk when saved and readable, else
-    /// generated with `rules` and queued for saving. A chunk that cannot be saved (a full
-    /// disk) is still returned, so players keep playing; the error is logged and recorded in
-    /// the store.
+    /// The chunk at (`x`, `z`) and its own light: from disk when saved and readable, else
+    /// generated with `rules` and queued for saving (without light: a chunk lit alone is not
+    /// lit right at its borders, see [`Encoder::encode_states`]). A chunk that cannot be saved
+    /// (a full disk) is still returned, so players keep playing; the error is logged and
+    /// recorded in the store.
     pub fn get(&self, scratch: &mut Scratch, rules: &BiomeRules, x: i32, z: i32) -> (UnloadedChunk, Light, Origin) {
         let Some(store) = &self.store else {
             let blocks = self.generator.blocks(rules, &self.palette, x, z);
@@ -84,7 +85,7 @@ impl ChunkSource {
         let blocks = self.generator.blocks(rules, &self.palette, x, z);
         let states = blocks.states();
         let light = Light::of_states(&states);
-        let nbt = scratch.encoder.encode_states(x, z, &blocks, &states, &light);
+        let nbt = scratch.encoder.encode_states(x, z, &blocks, &states, None);
         if let Err(e) = store.save(x, z, &nbt) {
             tracing::error!("{e}");
         }
@@ -99,11 +100,12 @@ impl ChunkSource {
         if store.contains(x, z)? {
             return Ok(false);
         }
-        // Encoded from the generator's arrays: no paletted chunk is built at all.
+        // Encoded from the generator's arrays: no paletted chunk is built at all. Saved
+        // without light, which Minecraft computes when it loads the chunk with its
+        // neighbours (this one's own would be too dark where light crosses its borders).
         let blocks = self.generator.blocks(rules, &self.palette, x, z);
         let states = blocks.states();
-        let light = Light::of_states(&states);
-        let nbt = scratch.encoder.encode_states(x, z, &blocks, &states, &light);
+        let nbt = scratch.encoder.encode_states(x, z, &blocks, &states, None);
         store.save(x, z, &nbt)?;
         Ok(true)
     }

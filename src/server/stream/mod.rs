@@ -54,6 +54,15 @@ pub struct Streamer {
     stats: Stats,
 }
 
+/// What [`Streamer::relight`] gives back.
+pub struct Relit {
+    /// Per chunk relit, in order: its light when it is right to the last block (joined: all
+    /// its neighbours are loaded), else `None`.
+    pub lights: Vec<Option<Arc<Light>>>,
+    /// The chunks whose light packet clients must get again.
+    pub changed: Vec<ChunkPos>,
+}
+
 struct Loaded {
     generation: u64,
     lit: Lit,
@@ -133,10 +142,8 @@ impl Streamer {
     }
 
     /// Loaded chunks now have these `own` lights (players edited them): their light and
-    /// their neighbours' are joined again where they can be. Returns their lights in the same
-    /// order (joined when all their neighbours are loaded) and the chunks whose light packet
-    /// clients must get again.
-    pub fn relight(&mut self, owns: Vec<(ChunkPos, Light)>) -> anyhow::Result<(Vec<Arc<Light>>, Vec<ChunkPos>)> {
+    /// their neighbours' are joined again where they can be.
+    pub fn relight(&mut self, owns: Vec<(ChunkPos, Light)>) -> anyhow::Result<Relit> {
         let mut lights = Vec::with_capacity(owns.len());
         let mut around = HashSet::new();
         for (pos, own) in owns {
@@ -161,8 +168,14 @@ impl Streamer {
                 joined.insert(p, Arc::new(light));
             }
         }
-        let lights = lights.into_iter().map(|(pos, own)| joined.get(&pos).cloned().unwrap_or(own)).collect();
-        Ok((lights, around.into_iter().filter(|p| self.loaded.contains_key(p)).collect()))
+        let lights = lights
+            .into_iter()
+            .map(|(pos, own)| {
+                let is_joined = self.loaded.get(&pos).is_some_and(|l| l.lit.is_joined());
+                is_joined.then(|| joined.get(&pos).cloned().unwrap_or(own))
+            })
+            .collect();
+        Ok(Relit { lights, changed: around.into_iter().filter(|p| self.loaded.contains_key(p)).collect() })
     }
 
     /// Joins the light of loaded chunk `pos` with its neighbours' if it is not joined yet

@@ -54,12 +54,19 @@ impl Encoder {
     /// writes a finished chunk: `DataVersion`, `xPos`, `zPos`, `yPos`, `Status`
     /// `"minecraft:full"`, `LastUpdate` and `InhabitedTime` 0 (nothing time-varying: the same
     /// chunk always encodes to the same bytes), `isLightOn`, `sections` (block states, biomes
-    /// and sky and block light; plus the light-only sections just below and above the world when they
-    /// have any light, as vanilla writes them), empty `block_entities` and `structures`.
-    /// `Heightmaps` are left out: Minecraft computes missing ones when it loads the chunk.
+    /// and sky and block light; plus the light-only sections just below and above the world
+    /// when they have any light, as vanilla writes them), empty `block_entities` and
+    /// `structures`. `Heightmaps` are left out: Minecraft computes missing ones when it loads
+    /// the chunk.
+    ///
+    /// `light` is the chunk's light when it is right to the last block — joined with its
+    /// neighbours' ([`Light::joined`]) — and is written with `isLightOn` 1. `None` writes no
+    /// light and `isLightOn` 0, which makes Minecraft light the chunk itself when it loads it,
+    /// as it does every chunk it generates: a chunk lit alone is darker than it should be
+    /// wherever light crosses its borders, and Minecraft would keep that light as it is.
     ///
     /// Panics when `light` is not the light of a chunk as high as `chunk`.
-    pub fn encode(&mut self, chunk_x: i32, chunk_z: i32, chunk: &UnloadedChunk, light: &Light) -> Vec<u8> {
+    pub fn encode(&mut self, chunk_x: i32, chunk_z: i32, chunk: &UnloadedChunk, light: Option<&Light>) -> Vec<u8> {
         self.encode_states(chunk_x, chunk_z, chunk, &States::of(chunk), light)
     }
 
@@ -70,10 +77,12 @@ impl Encoder {
         chunk_z: i32,
         chunk: &impl Chunk,
         states: &States,
-        light: &Light,
+        light: Option<&Light>,
     ) -> Vec<u8> {
         let sections = (chunk.height() / 16) as usize;
-        assert_eq!(light.section_count(), sections + 2, "light of a chunk of another height");
+        if let Some(light) = light {
+            assert_eq!(light.section_count(), sections + 2, "light of a chunk of another height");
+        }
         let min_section = self.min_y.div_euclid(16);
         let mut w = Writer(Vec::with_capacity(self.last_len + self.last_len / 8));
         w.tag(tag::COMPOUND, "");
@@ -84,12 +93,12 @@ impl Encoder {
         w.string("Status", "minecraft:full");
         w.long("LastUpdate", 0);
         w.long("InhabitedTime", 0);
-        w.byte("isLightOn", 1);
+        w.byte("isLightOn", i8::from(light.is_some()));
 
         // Light-only sections are written only when they carry light, so count first.
         // (Nothing glows outside the world, so those two carry sky light only.)
-        let below = light.sky_bytes(0);
-        let above = light.sky_bytes(sections + 1);
+        let below = light.and_then(|l| l.sky_bytes(0));
+        let above = light.and_then(|l| l.sky_bytes(sections + 1));
         let count = sections + usize::from(below.is_some()) + usize::from(above.is_some());
         w.list("sections", tag::COMPOUND, count);
         if let Some(bytes) = below {
@@ -101,10 +110,10 @@ impl Encoder {
             w.byte("Y", (min_section + s as i32) as i8);
             self.block_states(&mut w, states.section(s as u32));
             self.biomes(&mut w, chunk, s as u32);
-            if let Some(bytes) = light.sky_bytes(s + 1) {
+            if let Some(bytes) = light.and_then(|l| l.sky_bytes(s + 1)) {
                 w.byte_array("SkyLight", bytes);
             }
-            if let Some(bytes) = light.block_bytes(s + 1) {
+            if let Some(bytes) = light.and_then(|l| l.block_bytes(s + 1)) {
                 w.byte_array("BlockLight", bytes);
             }
             w.end();

@@ -31,7 +31,7 @@ fn decoder() -> Decoder {
 }
 
 fn encode(chunk: &UnloadedChunk, x: i32, z: i32) -> Vec<u8> {
-    encoder().encode(x, z, chunk, &Light::of(chunk))
+    encoder().encode(x, z, chunk, Some(&Light::of(chunk)))
 }
 
 fn parse(bytes: &[u8]) -> Compound {
@@ -147,7 +147,7 @@ fn a_varied_chunk_round_trips() {
 fn the_header_and_light_are_as_vanilla_writes_them() {
     let chunk = varied_chunk();
     let light = Light::of(&chunk);
-    let mut root = parse(&encoder().encode(3, -7, &chunk, &light));
+    let mut root = parse(&encoder().encode(3, -7, &chunk, Some(&light)));
     assert_eq!(root.get("DataVersion"), Some(&Value::Int(3465)));
     assert_eq!(root.get("xPos"), Some(&Value::Int(3)));
     assert_eq!(root.get("zPos"), Some(&Value::Int(-7)));
@@ -174,10 +174,22 @@ fn the_header_and_light_are_as_vanilla_writes_them() {
     let mut glowing = varied_chunk();
     glowing.set_block_state(4, 20, 4, BlockState::LAVA);
     let light = Light::of(&glowing);
-    let mut root = parse(&encoder().encode(3, -7, &glowing, &light));
+    let mut root = parse(&encoder().encode(3, -7, &glowing, Some(&light)));
     let lit: Vec<i8> = light.block_bytes(2).expect("the lava's section is lit").iter().map(|&v| v as i8).collect();
     assert_eq!(section(&mut root, -3).get("BlockLight"), Some(&Value::ByteArray(lit)));
     assert!(section(&mut root, 0).get("BlockLight").is_none());
+}
+
+#[test]
+fn a_chunk_saved_without_light_asks_minecraft_to_light_it() {
+    let chunk = varied_chunk();
+    let mut root = parse(&encoder().encode(3, -7, &chunk, None));
+    assert_eq!(root.get("isLightOn"), Some(&Value::Byte(0)), "Minecraft lights the chunk when it loads it");
+    let ys: Vec<_> = sections(&mut root).iter().map(|s| s.get("Y").cloned()).collect();
+    assert_eq!(ys, (-4..20).map(|y| Some(Value::Byte(y))).collect::<Vec<_>>(), "the world's sections only");
+    assert!(sections(&mut root).iter().all(|s| s.get("SkyLight").is_none() && s.get("BlockLight").is_none()));
+    let back = decode_ok(&encoder().encode(3, -7, &chunk, None), 3, -7);
+    assert_same(&chunk, &back);
 }
 
 #[test]
@@ -310,10 +322,11 @@ fn the_same_chunk_encodes_to_the_same_bytes() {
     let chunk = varied_chunk();
     let light = Light::of(&chunk);
     let mut reused = encoder();
-    let first = reused.encode(1, 2, &chunk, &light);
-    let _other = reused.encode(0, 0, &palette_chunk(&[300, 5], &[7]), &Light::of(&UnloadedChunk::with_height(HEIGHT)));
-    assert_eq!(first, reused.encode(1, 2, &chunk, &light), "a reused encoder");
-    assert_eq!(first, encoder().encode(1, 2, &chunk, &light), "a fresh encoder");
+    let first = reused.encode(1, 2, &chunk, Some(&light));
+    let _other =
+        reused.encode(0, 0, &palette_chunk(&[300, 5], &[7]), Some(&Light::of(&UnloadedChunk::with_height(HEIGHT))));
+    assert_eq!(first, reused.encode(1, 2, &chunk, Some(&light)), "a reused encoder");
+    assert_eq!(first, encoder().encode(1, 2, &chunk, Some(&light)), "a fresh encoder");
 }
 
 #[test]
@@ -425,7 +438,7 @@ fn generated_chunks_round_trip() {
     let start = Instant::now();
     let mut bytes = Vec::new();
     for _ in 0..rounds {
-        bytes = chunks.iter().zip(&lights).map(|((x, z, c), l)| encoder.encode(*x, *z, c, l)).collect::<Vec<_>>();
+        bytes = chunks.iter().zip(&lights).map(|((x, z, c), l)| encoder.encode(*x, *z, c, Some(l))).collect::<Vec<_>>();
     }
     let per_chunk = start.elapsed() / (rounds * chunks.len() as u32);
     eprintln!(
