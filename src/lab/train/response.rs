@@ -77,7 +77,8 @@ pub fn knots(probes: &[Probe], offsets: &[f64]) -> Vec<[f64; 2]> {
 }
 
 /// `relief_z` of every `window`-sided crop of `h` (side `size`, its smooth context `low`)
-/// at stride `window / 2`, row-major: the grid the pipeline's windows lie on.
+/// at stride `window / 2`, row-major: crops every half window, a dense sample of the relief
+/// windows see (the core's own windows lie every three quarters of one).
 fn crop_reliefs(h: &[f32], low: &[f32], size: usize, window: usize, norm: &Normalisation) -> Vec<f64> {
     let tile = EncodedTile { size, h: h.to_vec(), low: low.to_vec() };
     crop_origins(size, window)

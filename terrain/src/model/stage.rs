@@ -1,7 +1,7 @@
 //! Learned stages as window functions of the infinite-tensor engine.
 //!
 //! [`LearnedStage`] runs a stage's model on 64×64 windows of its own grid (the manifest's
-//! stride: 32, ≈50 % overlap, unless it says otherwise). Its conditioning is a field
+//! stride: half a window unless it says otherwise; the core's is 48, a quarter overlap). Its conditioning is a field
 //! `context.factor`× coarser than that grid (8× for the core: the coarse stage, or the layout
 //! standing in for it), bilinearly upsampled from globally aligned cells so every window sees
 //! the same values where windows overlap. Its noise comes from
