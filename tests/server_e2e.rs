@@ -28,6 +28,21 @@ fn assert_surveyed_columns(report: &Value, columns: &[(i64, i64)], generator: &G
         let y = c["y"].as_i64().expect("y");
         if s.y >= v.water_top_y() {
             land += 1;
+        }
+        if let Some(water) = s.water_y {
+            // Sea, river or lake: the water's surface is the top (a river may have cut its bed
+            // below sea level near the coast, its surface still above it).
+            assert_eq!(y, i64::from(water), "water surface at ({x}, {z}): {c}");
+            assert!(water > s.y, "water over the ground at ({x}, {z}): {c}");
+            assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
+            // One level less per block of water or ice; under one block of water the block
+            // below its surface is the (dark) bed.
+            assert_eq!(c["sky_light_above"], 15, "{c}");
+            assert_eq!(c["sky_light_at"], 14, "{c}");
+            let below = if s.y < water - 1 { 13 } else { 0 };
+            assert_eq!(c["sky_light_below"], below, "{c}");
+        } else {
+            assert!(s.y >= v.water_top_y(), "a column under sea level holds water: ({x}, {z}): {c}");
             assert_eq!(y, i64::from(s.y), "top of column ({x}, {z}): {c}");
             assert_eq!(c["block"], s.top, "ground block of ({x}, {z})");
             assert_eq!(c["biome"], short(&s.biome), "biome at ({x}, {}, {z})", s.y);
@@ -36,15 +51,6 @@ fn assert_surveyed_columns(report: &Value, columns: &[(i64, i64)], generator: &G
                 assert_eq!(c["sky_light_above"], 15, "{c}");
             }
             assert_eq!(c["sky_light_at"], 0, "{c}");
-        } else {
-            assert_eq!(y, i64::from(v.water_top_y()), "sea surface at ({x}, {z}): {c}");
-            assert!(matches!(c["block"].as_str(), Some("water" | "ice")), "{c}");
-            // One level less per block of water or ice; the shallowest sea is one block deep,
-            // so the block below its surface is the (dark) sea floor.
-            assert_eq!(c["sky_light_above"], 15, "{c}");
-            assert_eq!(c["sky_light_at"], 14, "{c}");
-            let below = if s.y < v.water_top_y() - 1 { 13 } else { 0 };
-            assert_eq!(c["sky_light_below"], below, "{c}");
         }
     }
     land
