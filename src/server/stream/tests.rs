@@ -170,12 +170,19 @@ fn a_client_disconnecting_unloads_the_chunks_only_it_saw() {
     assert!(status.cached <= CACHE as usize, "{status:?}");
 }
 
-#[test]
-fn chunks_whose_neighbours_are_all_loaded_are_sent_their_joined_light() {
+/// The app with one client at block (8, 8) and every chunk of its view loaded; the layer and
+/// the view.
+fn one_view_loaded() -> (App, Entity, HashSet<ChunkPos>) {
     let (mut app, layer) = app();
     join(&mut app, layer, "looker", 8.0, 8.0);
     let view = view_of(8.0, 8.0);
     tick_until(&mut app, "the view", |app| in_layer(app, layer) == view);
+    (app, layer, view)
+}
+
+#[test]
+fn chunks_whose_neighbours_are_all_loaded_are_sent_their_joined_light() {
+    let (app, _, view) = one_view_loaded();
     let setup = app.world.resource::<WorldSetup>();
     let palette = app.world.resource::<dimension::Palette>().0.clone();
     let own = |p: ChunkPos| Light::of_states(&setup.generator.blocks(&setup.rules, &palette, p.x, p.z).states());
@@ -204,10 +211,7 @@ fn chunks_whose_neighbours_are_all_loaded_are_sent_their_joined_light() {
 
 #[test]
 fn an_edit_relights_the_chunks_around_it_as_their_blocks_now_are() {
-    let (mut app, layer) = app();
-    join(&mut app, layer, "digger", 8.0, 8.0);
-    let view = view_of(8.0, 8.0);
-    tick_until(&mut app, "the view", |app| in_layer(app, layer) == view);
+    let (mut app, layer, view) = one_view_loaded();
     let v = *app.world.resource::<WorldSetup>().generator.vertical();
     // A shaft from the sky down the east edge of chunk 0, 0 (x 15, z 8) to 20 blocks under
     // the ground, and a tunnel from its foot east into chunk 1, 0: a player's digging.
