@@ -2,8 +2,8 @@
 //! who sees it is shown (valence sends the block update to the chunk's viewers), its light and
 //! its neighbours' are computed again and resent, and the chunk is saved over its generated
 //! copy — a saved chunk is always loaded rather than generated, so the edit survives
-//! unloading, reconnects and restarts (unless `world.save_chunks` is off, when edits live only while the chunk is
-//! in memory).
+//! unloading, reconnects and restarts (unless `world.save_chunks` is off, when edits live
+//! only while the chunk is in memory).
 //!
 //! Creative players break a block at the first hit; survival players when their client has
 //! finished digging it (the client times the dig by the held tool, as vanilla's does). A held
@@ -130,15 +130,14 @@ fn save_edited(
         return;
     }
     let (Ok(layer), Some(mut saver), Some(mut streamer)) = (layers.get_single(), saver, streamer) else { return };
-    let mut chunks = Vec::new();
+    let (mut chunks, mut owns) = (Vec::new(), Vec::new());
     for pos in edited.0.drain() {
         if let Some(chunk) = layer.chunk(pos) {
             let states = States::of(chunk);
-            let light = Light::of_states(&states);
-            chunks.push((pos, chunk, states, light));
+            owns.push((pos, Light::of_states(&states)));
+            chunks.push((pos, chunk, states));
         }
     }
-    let owns = chunks.iter().map(|(pos, _, _, light)| (*pos, light.clone())).collect();
     let lights = match streamer.relight(owns) {
         Ok(Relit { lights, changed }) => {
             for pos in changed {
@@ -154,7 +153,7 @@ fn save_edited(
         }
     };
     let Some(store) = saver.store.clone() else { return };
-    for ((pos, chunk, states, _), light) in chunks.iter().zip(lights) {
+    for ((pos, chunk, states), light) in chunks.iter().zip(lights) {
         let nbt = saver.encoder.encode_states(pos.x, pos.z, *chunk, states, light.as_deref());
         if let Err(e) = store.save(pos.x, pos.z, &nbt) {
             tracing::error!("saving edited chunk {}, {}: {e}", pos.x, pos.z);

@@ -144,16 +144,13 @@ impl Streamer {
     /// Loaded chunks now have these `own` lights (players edited them): their light and
     /// their neighbours' are joined again where they can be.
     pub fn relight(&mut self, owns: Vec<(ChunkPos, Light)>) -> anyhow::Result<Relit> {
-        let mut lights = Vec::with_capacity(owns.len());
+        let relit: Vec<ChunkPos> = owns.iter().map(|(pos, _)| *pos).collect();
         let mut around = HashSet::new();
         for (pos, own) in owns {
-            let Some(loaded) = self.loaded.get_mut(&pos) else {
-                lights.push((pos, Arc::new(own)));
-                continue;
-            };
-            loaded.lit = Lit::alone(pos, own, self.compression)?;
-            lights.push((pos, loaded.lit.own.clone()));
-            around.extend(light::area(pos));
+            if let Some(loaded) = self.loaded.get_mut(&pos) {
+                loaded.lit = Lit::alone(pos, own, self.compression)?;
+                around.extend(light::area(pos));
+            }
         }
         for &p in &around {
             match self.loaded.get_mut(&p) {
@@ -168,11 +165,11 @@ impl Streamer {
                 joined.insert(p, Arc::new(light));
             }
         }
-        let lights = lights
-            .into_iter()
-            .map(|(pos, own)| {
-                let is_joined = self.loaded.get(&pos).is_some_and(|l| l.lit.is_joined());
-                is_joined.then(|| joined.get(&pos).cloned().unwrap_or(own))
+        let lights = relit
+            .iter()
+            .map(|pos| {
+                let lit = &self.loaded.get(pos)?.lit;
+                lit.is_joined().then(|| joined.get(pos).cloned().unwrap_or_else(|| lit.own.clone()))
             })
             .collect();
         Ok(Relit { lights, changed: around.into_iter().filter(|p| self.loaded.contains_key(p)).collect() })
@@ -182,12 +179,14 @@ impl Streamer {
     /// and they are all loaded. Returns the joined light when that let light in (its packet
     /// changed).
     fn join(&mut self, pos: ChunkPos) -> anyhow::Result<Option<Light>> {
-        let area = light::area(pos);
-        let lights: Vec<&Arc<Light>> = area.iter().filter_map(|p| self.loaded.get(p)).map(|l| &l.lit.own).collect();
-        if lights.len() < 9 || self.loaded[&pos].lit.is_joined() {
+        let area = light::area(pos).map(|p| self.loaded.get(&p).map(|l| &*l.lit.own));
+        if self.loaded.get(&pos).is_none_or(|l| l.lit.is_joined()) {
             return Ok(None);
         }
-        let joined = Light::joined(std::array::from_fn(|i| &**lights[i]));
+        let Some(area) = area.into_iter().collect::<Option<Vec<&Light>>>() else {
+            return Ok(None); // A neighbour is not loaded yet.
+        };
+        let joined = Light::joined(std::array::from_fn(|i| area[i]));
         let compression = self.compression;
         if let Some(loaded) = self.loaded.get_mut(&pos) {
             loaded.lit.set_joined(pos, joined.as_ref(), compression)?;
