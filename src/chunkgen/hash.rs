@@ -2,6 +2,8 @@
 //! (world seed, purpose, global coordinates), so chunks agree across borders whatever order
 //! they are built in.
 
+use crate::terrain::noise::floor;
+
 /// A well-mixed 64-bit hash of the seed, a purpose tag and a position (SplitMix64 finaliser).
 pub fn hash3(seed: u64, salt: u64, x: i64, y: i64, z: i64) -> u64 {
     let mut h = seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15);
@@ -43,7 +45,8 @@ fn mix(mut z: u64) -> u64 {
 /// trilinear between hashed lattice points, smoothstepped. For caves, sampled on a coarse
 /// lattice and interpolated between.
 pub fn value_noise3(seed: u64, salt: u64, x: f64, y: f64, z: f64) -> f32 {
-    let (ix, iy, iz) = (x.floor(), y.floor(), z.floor());
+    // `floor` by conversion: `f64::floor` is a libm call on the baseline x86-64 target.
+    let (ix, iy, iz) = (floor(x), floor(y), floor(z));
     let (fx, fy, fz) = (smooth((x - ix) as f32), smooth((y - iy) as f32), smooth((z - iz) as f32));
     let (ix, iy, iz) = (ix as i64, iy as i64, iz as i64);
     let at = |dx: i64, dy: i64, dz: i64| unit3(seed, salt, ix + dx, iy + dy, iz + dz);

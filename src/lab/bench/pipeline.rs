@@ -9,13 +9,28 @@ use crate::terrain::{Pipeline, Rect};
 /// Cold 512×512-block region, and chunk-by-chunk steady exploration.
 pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>> {
     let (mut first_region, mut steady, mut warm) = (Vec::new(), Vec::new(), Vec::new());
+    // Per window function, summed over the runs: what the cold region needed.
+    let mut needed: Vec<(String, f64, Vec<f64>)> = Vec::new();
+    let (threads, mut busy) = (std::thread::available_parallelism().map_or(1, |n| n.get()), Vec::new());
     for run in 0..runs as i64 {
         // A different far place per run, so each starts cold.
         let origin = (run * 1_000_003 - 3_000_000, -run * 700_001 + 2_000_000);
         let pipeline = Pipeline::build(config.world.seed, &config.terrain())?;
-        let start = Instant::now();
+        let (start, cpu) = (Instant::now(), super::pregen::cpu_seconds());
         pipeline.columns(Rect::new(origin.1, origin.0, 512, 512));
         first_region.push(start.elapsed().as_secs_f64());
+        if let (Some(before), Some(after)) = (cpu, super::pregen::cpu_seconds()) {
+            busy.push(100.0 * (after - before) / (start.elapsed().as_secs_f64() * threads as f64));
+        }
+        for f in pipeline.engine().function_stats() {
+            match needed.iter_mut().find(|n| n.0 == f.name) {
+                Some(n) => {
+                    n.1 += f.windows as f64;
+                    n.2.push(f.seconds);
+                }
+                None => needed.push((f.name, f.windows as f64, vec![f.seconds])),
+            }
+        }
 
         // Steady exploration: a player's new chunks, one 16×16 query each, walking east
         // across fresh ground in a band 32 chunks wide.
@@ -40,9 +55,21 @@ pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>>
         }
         warm.push(columns as f64 / start.elapsed().as_secs_f64());
     }
-    Ok(vec![
+    let mut out = vec![
         Measurement::new("pipeline: first 512×512-block region, cold start", "s", first_region),
-        Measurement::new("pipeline: steady exploration, chunk-sized queries", "columns/s", steady),
-        Measurement::new("pipeline: revisiting generated chunks (cache warm)", "columns/s", warm),
-    ])
+        Measurement::new("  how busy the hardware threads were meanwhile", "%", busy),
+    ];
+    // Where the cold region's time goes: windows per run, and seconds summed over threads
+    // (inclusive: a function that queries another counts the time it waited for it).
+    for (name, windows, seconds) in needed {
+        out.push(Measurement::new(
+            &format!("  windows of {name} it evaluated"),
+            "windows",
+            vec![windows / runs as f64],
+        ));
+        out.push(Measurement::new(&format!("  seconds in {name}, inclusive"), "s", seconds));
+    }
+    out.push(Measurement::new("pipeline: steady exploration, chunk-sized queries", "columns/s", steady));
+    out.push(Measurement::new("pipeline: revisiting generated chunks (cache warm)", "columns/s", warm));
+    Ok(out)
 }

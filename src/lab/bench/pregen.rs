@@ -81,13 +81,13 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     // A player joining a place nobody has been, in a warm server: every chunk of view
     // distance 10, nearest first, on the worker threads (network not included).
     let rig = Rig::new(config, &rules)?;
-    let mut join = Vec::new();
+    let (mut join, mut busy) = (Vec::new(), Vec::new());
     for run in 0..runs as i32 {
         let centre = ChunkPos::new(-40_000 - run * 1_000, 25_000 + run * 1_000);
         let mut wanted: Vec<ChunkPos> = ChunkView::new(centre, 10).iter().collect();
         wanted.sort_by_key(|p| std::cmp::Reverse(centre.distance_squared(*p)));
         let queue = std::sync::Mutex::new(wanted);
-        let start = Instant::now();
+        let (start, cpu) = (Instant::now(), cpu_seconds());
         std::thread::scope(|scope| {
             for _ in 0..threads {
                 let (queue, rig) = (&queue, &rig);
@@ -100,8 +100,14 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
             }
         });
         join.push(start.elapsed().as_secs_f64());
+        if let (Some(before), Some(after)) = (cpu, cpu_seconds()) {
+            let hardware = std::thread::available_parallelism().map_or(1, |n| n.get());
+            busy.push(100.0 * (after - before) / (start.elapsed().as_secs_f64() * hardware as f64));
+        }
     }
     out.push(Measurement::new("join: all 441 chunks of view 10 at a new place, warm server", "s", join));
+    // Below 100 %, the join waits on work that one thread does while the others idle.
+    out.push(Measurement::new("  how busy the hardware threads were meanwhile", "%", busy));
 
     // Where a chunk's time goes, one thread, chunks in pre-generation order: far east
     // (mostly sea, the same sample as every earlier table), then on land by the spawn, where
@@ -195,6 +201,17 @@ fn per_chunk(generator: &Generator, rules: &BiomeRules, task: Task, label: &str,
 /// peak reported is that of the run that follows.
 fn reset_peak_rss() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// CPU time this process has used (user and system, all threads), seconds (Linux:
+/// `/proc/self/stat`, in the kernel's clock ticks of 1/100 s).
+pub fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces, so split after its ')').
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok());
+    // utime and stime are fields 14 and 15 of the line, 12 and 13 after the name.
+    Some((ticks(11)? + ticks(12)?) / 100.0)
 }
 
 /// Peak resident memory of this process since start (or the last reset), MiB.

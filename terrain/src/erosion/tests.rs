@@ -97,3 +97,26 @@ fn the_carving_is_continuous_across_every_octave_s_lattice_lines() {
         }
     }
 }
+
+#[test]
+fn remembering_the_lattice_changes_no_bit_in_any_visiting_order() {
+    let filter = ErosionFilter::new(41);
+    // Rows of neighbouring columns (mostly the same cells), then jumps between far places
+    // and back (the remembered cells go stale), each visited with one shared lattice.
+    let mut points: Vec<(f64, f64)> = (0..400).map(|i| (f64::from(i % 40) * 40.0, f64::from(i / 40) * 40.0)).collect();
+    points
+        .extend((0..200).map(|i| if i % 2 == 0 { (-3.0e6 + f64::from(i), 2.0e5) } else { (f64::from(i) * 13.0, 7.0) }));
+    let mut lattice = Lattice::default();
+    for (n, &(x, z)) in points.iter().enumerate() {
+        let gradient = (0.05 * (n as f64 * 0.3).sin(), 0.05 * (n as f64 * 0.7).cos());
+        let fresh = filter.apply(x, z, 0.2, gradient, 0..10);
+        let remembered = filter.apply_with(&mut lattice, x, z, 0.2, gradient, 0..10);
+        assert_eq!(fresh.height.to_bits(), remembered.height.to_bits(), "height at ({x}, {z})");
+        assert_eq!(fresh.gradient.0.to_bits(), remembered.gradient.0.to_bits());
+        assert_eq!(fresh.gradient.1.to_bits(), remembered.gradient.1.to_bits());
+    }
+    // Another seed through the same lattice: its points are its own.
+    let other = ErosionFilter::new(42);
+    let (x, z) = points[399];
+    assert_eq!(other.apply(x, z, 0.2, (0.1, 0.0), 0..10), other.apply_with(&mut lattice, x, z, 0.2, (0.1, 0.0), 0..10));
+}

@@ -141,7 +141,14 @@ impl Piece {
             let (dx, dz) = (q[0] - p[0], q[1] - p[1]);
             let len2 = dx * dx + dz * dz;
             let t = if len2 > 0.0 { (((x - p[0]) * dx + (z - p[1]) * dz) / len2).clamp(0.0, 1.0) } else { 0.0 };
-            let d = (x - p[0] - t * dx).hypot(z - p[1] - t * dz);
+            let (ex, ez) = (x - p[0] - t * dx, z - p[1] - t * dz);
+            // `hypot` is a libm call, and most segments lie farther than the nearest so far,
+            // which the square shows without it (the margin is far above its rounding, so
+            // the same segment wins either way).
+            if ex * ex + ez * ez > best.0 * best.0 * (1.0 + 1e-9) {
+                continue;
+            }
+            let d = ex.hypot(ez);
             if d < best.0 {
                 best = (d, p[2] + t * (q[2] - p[2]), p[3] + t * (q[3] - p[3]), p[4] + t * (q[4] - p[4]));
             }

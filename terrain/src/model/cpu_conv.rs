@@ -137,58 +137,79 @@ pub fn convolve(x: &[f32], [b, cin, h, w]: [usize; 4], weight: &[f32], cout: usi
             let y1 = (y0 + rows_per_band).min(h);
             let q0 = y0 * pw;
             let n = (y1 * pw).min(positions) - q0;
-            let mut rhs = vec![0.0f32; depth * n];
-            for tap in 0..taps {
-                let off = (tap / k) * pw + tap % k;
-                for ci in 0..cin {
-                    let src = (img * cin + ci) * plane + q0 + off;
-                    let row = (tap * cin + ci) * n;
-                    rhs[row..row + n].copy_from_slice(&padded[src..src + n]);
+            SCRATCH.with_borrow_mut(|rhs| {
+                // Every row is written below: the buffer is only grown, never cleared (zeroing
+                // it for each band cost as much as copying the rows in).
+                if rhs.len() < depth * n {
+                    rhs.resize(depth * n, 0.0);
                 }
-            }
-            let mut dst = vec![0.0f32; cout * n];
-            // SAFETY: dst is cout × n (row stride n), lhs cout × depth (row stride depth), rhs
-            // depth × n (row stride n), all contiguous and exactly that long.
-            unsafe {
-                gemm::gemm(
-                    cout,
-                    n,
-                    depth,
-                    dst.as_mut_ptr(),
-                    1,
-                    n as isize,
-                    false,
-                    lhs.as_ptr(),
-                    1,
-                    depth as isize,
-                    rhs.as_ptr(),
-                    1,
-                    n as isize,
-                    0.0,
-                    1.0,
-                    false,
-                    false,
-                    false,
-                    gemm::Parallelism::None,
-                );
-            }
-            dst
+                for tap in 0..taps {
+                    let off = (tap / k) * pw + tap % k;
+                    for ci in 0..cin {
+                        let src = (img * cin + ci) * plane + q0 + off;
+                        let row = (tap * cin + ci) * n;
+                        rhs[row..row + n].copy_from_slice(&padded[src..src + n]);
+                    }
+                }
+                let mut dst = Vec::with_capacity(cout * n);
+                // SAFETY: dst has capacity cout × n (row stride n), lhs is cout × depth (row
+                // stride depth), rhs at least depth × n (row stride n), all contiguous. With
+                // `read_dst` false the GEMM writes every element of dst without reading it, so
+                // its length is set only once all of it is initialised.
+                unsafe {
+                    gemm::gemm(
+                        cout,
+                        n,
+                        depth,
+                        dst.as_mut_ptr(),
+                        1,
+                        n as isize,
+                        false,
+                        lhs.as_ptr(),
+                        1,
+                        depth as isize,
+                        rhs.as_ptr(),
+                        1,
+                        n as isize,
+                        0.0,
+                        1.0,
+                        false,
+                        false,
+                        false,
+                        gemm::Parallelism::None,
+                    );
+                    dst.set_len(cout * n);
+                }
+                dst
+            })
         })
         .collect();
 
-    let mut out = vec![0.0f32; b * cout * h * w];
-    for (&(img, y0), dst) in bands.iter().zip(&results) {
-        let y1 = (y0 + rows_per_band).min(h);
-        let n = dst.len() / cout;
+    let mut out = Vec::with_capacity(b * cout * h * w);
+    // Bands in order: image, then rows; within a band each output channel's rows. The
+    // output is `[b, c_out, h, w]`, so an image's channels interleave the bands' rows.
+    let per_image = h.div_ceil(rows_per_band);
+    for (img, image_bands) in results.chunks(per_image).enumerate() {
+        debug_assert!(bands[img * per_image].0 == img);
         for co in 0..cout {
-            for y in y0..y1 {
-                let src = co * n + (y - y0) * pw;
-                let at = ((img * cout + co) * h + y) * w;
-                out[at..at + w].copy_from_slice(&dst[src..src + w]);
+            for (band, dst) in image_bands.iter().enumerate() {
+                let y0 = band * rows_per_band;
+                let y1 = (y0 + rows_per_band).min(h);
+                let n = dst.len() / cout;
+                for y in y0..y1 {
+                    let src = co * n + (y - y0) * pw;
+                    out.extend_from_slice(&dst[src..src + w]);
+                }
             }
         }
     }
+    debug_assert_eq!(out.len(), b * cout * h * w);
     out
+}
+
+thread_local! {
+    /// Each thread's im2col buffer, reused from band to band and call to call.
+    static SCRATCH: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
+use crate::erosion::{octaves_between, ErosionFilter, Lattice, SHORTEST_ON_GRID_PIXELS};
 use crate::infinite::Source;
 use crate::resample;
 use crate::tile::{Rect, Tile};
@@ -49,10 +49,11 @@ impl Source for Finest {
         let g = self.metres;
         let mut out = Tile::zeros(2, rect);
         let n = rect.area();
+        let mut lattice = Lattice::default();
         let mut i = 0;
         for y in rect.y0..rect.y1() {
             for x in rect.x0..rect.x1() {
-                let (elevation, slope) = carve_cell(&self.erosion, &e, g, (y, x), self.octaves.clone());
+                let (elevation, slope) = carve_cell(&self.erosion, &mut lattice, &e, g, (y, x), self.octaves.clone());
                 out.data[i] = elevation as f32;
                 out.data[n + i] = slope as f32;
                 i += 1;
@@ -67,6 +68,7 @@ impl Source for Finest {
 /// neighbours: (carved elevation, slope). Shared by every grid the filter is carved on.
 pub(super) fn carve_cell(
     erosion: &ErosionFilter,
+    lattice: &mut Lattice,
     e: &impl Fn(i64, i64) -> f64,
     g: f64,
     (y, x): (i64, i64),
@@ -75,5 +77,5 @@ pub(super) fn carve_cell(
     let gradient = ((e(y, x + 1) - e(y, x - 1)) / (2.0 * g), (e(y + 1, x) - e(y - 1, x)) / (2.0 * g));
     let slope = gradient.0.hypot(gradient.1);
     let (xm, zm) = ((x as f64 + 0.5) * g, (y as f64 + 0.5) * g);
-    (e(y, x) + erosion.apply(xm, zm, slope, gradient, octaves).height, slope)
+    (e(y, x) + erosion.apply_with(lattice, xm, zm, slope, gradient, octaves).height, slope)
 }

@@ -20,7 +20,7 @@ pub use stages::{LearnedStageSpec, StageState, StageStatus, LEARNED};
 
 use crate::climate::{precipitation, temperature_at, Orographic, OrographicSweep};
 use crate::encoding::box_downsample;
-use crate::erosion::{octaves_between, ErosionFilter, SHORTEST_ON_GRID_PIXELS};
+use crate::erosion::{octaves_between, ErosionFilter, Lattice, SHORTEST_ON_GRID_PIXELS};
 use crate::hydrology::continental::Continental;
 use crate::hydrology::{Basins, Rivers, Stitched, WaterColumns, CELL_METRES, RIVER_DISTANCE_MAX_M};
 use crate::infinite::{tiled, Engine, EngineConfig, EngineStats, Source, WindowLayout, Windowed};
@@ -457,13 +457,14 @@ impl Pipeline {
         let octaves = octaves_between(2.0 * b, SHORTEST_ON_GRID_PIXELS * g);
         let n = blocks.area();
         let mut out = cubic.data;
+        let mut lattice = Lattice::default();
         let mut i = 0;
         for z in blocks.y0..blocks.y1() {
             for x in blocks.x0..blocks.x1() {
                 let gradient = (f64::from(fields.data[i]), f64::from(fields.data[n + i]));
                 let slope = f64::from(fields.data[2 * n + i]);
                 let (xm, zm) = ((x as f64 + 0.5) * b, (z as f64 + 0.5) * b);
-                out[i] += self.erosion.apply(xm, zm, slope, gradient, octaves.clone()).height as f32;
+                out[i] += self.erosion.apply_with(&mut lattice, xm, zm, slope, gradient, octaves.clone()).height as f32;
                 i += 1;
             }
         }

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use crate::climate::{precipitation, temperature_at};
 use crate::encoding::box_downsample;
-use crate::erosion::{octaves_between, ErosionFilter};
+use crate::erosion::{octaves_between, ErosionFilter, Lattice};
 use crate::hydrology::input;
 use crate::infinite::Source;
 use crate::layout::sketch;
@@ -73,10 +73,11 @@ impl Source for NetworkInputs {
         let coarse = resample::source_rect(&rect, ratio, 0);
         let rain = resample::bilinear(&self.precipitation.query(coarse), ratio, rect);
         let climate = resample::bilinear(&self.sketch.query(coarse), ratio, rect);
+        let mut lattice = Lattice::default();
         let mut i = 0;
         for y in rect.y0..rect.y1() {
             for x in rect.x0..rect.x1() {
-                let elevation = carve_cell(&self.erosion, &e, g, (y, x), octaves.clone()).0 as f32;
+                let elevation = carve_cell(&self.erosion, &mut lattice, &e, g, (y, x), octaves.clone()).0 as f32;
                 out.data[input::ELEVATION * n + i] = elevation;
                 out.data[input::PRECIPITATION * n + i] = rain.channel(precipitation::ANNUAL_MM)[i];
                 let t0 = climate.channel(sketch::SEA_LEVEL_TEMPERATURE)[i] + self.temperature_offset_c;
