@@ -2,6 +2,7 @@
 
 use std::time::Instant;
 
+use super::pregen::{busy_percent, cpu_seconds};
 use super::Measurement;
 use crate::config::Config;
 use crate::terrain::{Pipeline, Rect};
@@ -11,17 +12,15 @@ pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>>
     let (mut first_region, mut steady, mut warm) = (Vec::new(), Vec::new(), Vec::new());
     // Per window function, summed over the runs: what the cold region needed.
     let mut needed: Vec<(String, f64, Vec<f64>)> = Vec::new();
-    let (threads, mut busy) = (std::thread::available_parallelism().map_or(1, |n| n.get()), Vec::new());
+    let mut busy = Vec::new();
     for run in 0..runs as i64 {
         // A different far place per run, so each starts cold.
         let origin = (run * 1_000_003 - 3_000_000, -run * 700_001 + 2_000_000);
         let pipeline = Pipeline::build(config.world.seed, &config.terrain())?;
-        let (start, cpu) = (Instant::now(), super::pregen::cpu_seconds());
+        let (start, cpu) = (Instant::now(), cpu_seconds());
         pipeline.columns(Rect::new(origin.1, origin.0, 512, 512));
         first_region.push(start.elapsed().as_secs_f64());
-        if let (Some(before), Some(after)) = (cpu, super::pregen::cpu_seconds()) {
-            busy.push(100.0 * (after - before) / (start.elapsed().as_secs_f64() * threads as f64));
-        }
+        busy.extend(busy_percent(start, cpu));
         for f in pipeline.engine().function_stats() {
             match needed.iter_mut().find(|n| n.0 == f.name) {
                 Some(n) => {

@@ -100,10 +100,7 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
             }
         });
         join.push(start.elapsed().as_secs_f64());
-        if let (Some(before), Some(after)) = (cpu, cpu_seconds()) {
-            let hardware = std::thread::available_parallelism().map_or(1, |n| n.get());
-            busy.push(100.0 * (after - before) / (start.elapsed().as_secs_f64() * hardware as f64));
-        }
+        busy.extend(busy_percent(start, cpu));
     }
     out.push(Measurement::new("join: all 441 chunks of view 10 at a new place, warm server", "s", join));
     // Below 100 %, the join waits on work that one thread does while the others idle.
@@ -212,6 +209,14 @@ pub fn cpu_seconds() -> Option<f64> {
     let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok());
     // utime and stime are fields 14 and 15 of the line, 12 and 13 after the name.
     Some((ticks(11)? + ticks(12)?) / 100.0)
+}
+
+/// How busy the hardware threads were since `start`, when the process had used `cpu`
+/// seconds of CPU ([`cpu_seconds`]), % of all of them.
+pub fn busy_percent(start: Instant, cpu: Option<f64>) -> Option<f64> {
+    let used = cpu_seconds()? - cpu?;
+    let hardware = std::thread::available_parallelism().map_or(1, |n| n.get());
+    Some(100.0 * used / (start.elapsed().as_secs_f64() * hardware as f64))
 }
 
 /// Peak resident memory of this process since start (or the last reset), MiB.

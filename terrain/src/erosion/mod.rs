@@ -172,7 +172,7 @@ impl ErosionFilter {
             let (px, pz) = turn((x / lambda, z / lambda));
             let (ix, iz) = (floor(px), floor(pz));
             let cell = (ix as i64, iz as i64);
-            let points = lattice.points(splitmix(self.seed ^ u64::from(k)), k, cell);
+            let points = lattice.points(self.seed, k, cell);
             let g = gullies(points, px - ix, pz - iz, turn(dir));
             // Back from the lattice's frame (the inverse turn) for the derivatives.
             let (dx, dz) = (cos * g.dx + sin * g.dz, -sin * g.dx + cos * g.dz);
@@ -192,17 +192,18 @@ pub struct Lattice {
     octaves: [Option<Cell>; MAX_OCTAVES as usize],
 }
 
-/// The octave's seed and the cell the points are for, and the 4 × 4 points' jitters
+/// The filter's seed and the cell the points are for, and the 4 × 4 points' jitters
 /// (offsets in half cells, row by row from the cell's (−1, −1) neighbour).
 type Cell = (u64, (i64, i64), [(f64, f64); 16]);
 
 impl Lattice {
-    /// The jitters of the 4 × 4 points around `cell` of the octave `k` seeded `seed`.
+    /// The jitters of the 4 × 4 points around `cell` of octave `k` of the filter seeded
+    /// `seed` (the octave's own seed is derived only when the points are hashed anew).
     fn points(&mut self, seed: u64, k: u32, cell: (i64, i64)) -> &[(f64, f64); 16] {
         let slot = &mut self.octaves[k as usize];
         match slot {
             Some((s, c, _)) if *s == seed && *c == cell => {}
-            _ => *slot = Some((seed, cell, jitters(seed, cell))),
+            _ => *slot = Some((seed, cell, jitters(splitmix(seed ^ u64::from(k)), cell))),
         }
         &slot.as_ref().expect("just filled").2
     }
