@@ -201,7 +201,7 @@ fn far_away_costs_the_same_windows_and_never_overflows() {
     let coarse_len = (512.0 / blocks_per_coarse_cell).ceil() as i64 + 3;
     let layout = WindowLayout::square(32, 16, 0);
     // The drainage network adds its tiles (at most 2 × 2 for 512 blocks of 40 m, with the
-    // rivers' reach, and as many stitched ones), and those reach at most 2 × 2 tiles of the
+    // rivers' reach, and the joined windows over them), and those reach at most 2 × 2 tiles of the
     // continent's drainage, whose margins hold the most coarse windows.
     use crate::hydrology::{continental, CELL_METRES, MARGIN, TILE};
     let network_len = ((2 * TILE + 2 * MARGIN) as f64 * CELL_METRES / COARSE_METRES).ceil() as i64 + 3;
