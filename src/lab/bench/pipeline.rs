@@ -2,6 +2,7 @@
 
 use std::time::Instant;
 
+use super::needed::Needed;
 use super::pregen::{busy_percent, cpu_seconds};
 use super::Measurement;
 use crate::config::Config;
@@ -11,7 +12,7 @@ use crate::terrain::{Pipeline, Rect};
 pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>> {
     let (mut first_region, mut steady, mut warm) = (Vec::new(), Vec::new(), Vec::new());
     // Per window function, summed over the runs: what the cold region needed.
-    let mut needed: Vec<(String, f64, Vec<f64>)> = Vec::new();
+    let mut needed = Needed::default();
     let mut busy = Vec::new();
     for run in 0..runs as i64 {
         // A different far place per run, so each starts cold.
@@ -21,15 +22,7 @@ pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>>
         pipeline.columns(Rect::new(origin.1, origin.0, 512, 512));
         first_region.push(start.elapsed().as_secs_f64());
         busy.extend(busy_percent(start, cpu));
-        for f in pipeline.engine().function_stats() {
-            match needed.iter_mut().find(|n| n.0 == f.name) {
-                Some(n) => {
-                    n.1 += f.windows as f64;
-                    n.2.push(f.seconds);
-                }
-                None => needed.push((f.name, f.windows as f64, vec![f.seconds])),
-            }
-        }
+        needed.add(&[], &pipeline.engine().function_stats());
 
         // Steady exploration: a player's new chunks, one 16×16 query each, walking east
         // across fresh ground in a band 32 chunks wide.
@@ -58,16 +51,8 @@ pub fn measure(config: &Config, runs: usize) -> anyhow::Result<Vec<Measurement>>
         Measurement::new("pipeline: first 512×512-block region, cold start", "s", first_region),
         Measurement::new("  how busy the hardware threads were meanwhile", "%", busy),
     ];
-    // Where the cold region's time goes: windows per run, and seconds summed over threads
-    // (inclusive: a function that queries another counts the time it waited for it).
-    for (name, windows, seconds) in needed {
-        out.push(Measurement::new(
-            &format!("  windows of {name} it evaluated"),
-            "windows",
-            vec![windows / runs as f64],
-        ));
-        out.push(Measurement::new(&format!("  seconds in {name}, inclusive"), "s", seconds));
-    }
+    // Where the cold region's time goes.
+    out.extend(needed.measurements());
     out.push(Measurement::new("pipeline: steady exploration, chunk-sized queries", "columns/s", steady));
     out.push(Measurement::new("pipeline: revisiting generated chunks (cache warm)", "columns/s", warm));
     Ok(out)

@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use valence::prelude::{ChunkPos, ChunkView};
 
+use super::needed::Needed;
 use super::Measurement;
 use crate::biome::BiomeRules;
 use crate::chunkgen::{BiomePalette, Generator, Light};
@@ -81,13 +82,14 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
     // A player joining a place nobody has been, in a warm server: every chunk of view
     // distance 10, nearest first, on the worker threads (network not included).
     let rig = Rig::new(config, &rules)?;
-    let (mut join, mut busy) = (Vec::new(), Vec::new());
+    let (mut join, mut busy, mut needed) = (Vec::new(), Vec::new(), Needed::default());
+    let engine = rig.source.generator().pipeline().engine();
     for run in 0..runs as i32 {
         let centre = ChunkPos::new(-40_000 - run * 1_000, 25_000 + run * 1_000);
         let mut wanted: Vec<ChunkPos> = ChunkView::new(centre, 10).iter().collect();
         wanted.sort_by_key(|p| std::cmp::Reverse(centre.distance_squared(*p)));
         let queue = std::sync::Mutex::new(wanted);
-        let (start, cpu) = (Instant::now(), cpu_seconds());
+        let (start, cpu, before) = (Instant::now(), cpu_seconds(), engine.function_stats());
         std::thread::scope(|scope| {
             for _ in 0..threads {
                 let (queue, rig) = (&queue, &rig);
@@ -101,10 +103,12 @@ pub fn measure(config: &Config, runs: usize, chunks: u64) -> anyhow::Result<Vec<
         });
         join.push(start.elapsed().as_secs_f64());
         busy.extend(busy_percent(start, cpu));
+        needed.add(&before, &engine.function_stats());
     }
     out.push(Measurement::new("join: all 441 chunks of view 10 at a new place, warm server", "s", join));
     // Below 100 %, the join waits on work that one thread does while the others idle.
     out.push(Measurement::new("  how busy the hardware threads were meanwhile", "%", busy));
+    out.extend(needed.measurements());
 
     // Where a chunk's time goes, one thread, chunks in pre-generation order: far east
     // (mostly sea, the same sample as every earlier table), then on land by the spawn, where
