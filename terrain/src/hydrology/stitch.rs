@@ -253,6 +253,7 @@ mod tests {
             assert_eq!(down(&t, y, TILE - 1), None);
         }
     }
+
     /// A per-tile network whose tiles disagree: a tilted surface with small bumps, raised by
     /// up to 3 m per tile, each cell linked to its lowest neighbour as its own tile sees it.
     /// Where a tile sits higher than the next, its border cells are pits that spill across,
