@@ -43,6 +43,12 @@ pub const COARSE_METRES: f64 = 8000.0;
 const COARSE_TILE: i64 = 64;
 /// Ratio of the 4× block upsampling (block size / model pixel size).
 const BLOCK_RATIO: f64 = 1.0 / BLOCKS_PER_MODEL_PIXEL as f64;
+/// Block columns from which a query is a region, not a chunk: its drainage network is
+/// evaluated beside its relief, and its carving split over the engine's threads (a chunk's
+/// query runs on one of many chunk workers, which keep the threads busy already).
+const REGION_QUERY_COLUMNS: usize = 128 * 128;
+/// Rows of block columns carved per task when a region's carving is split.
+const CARVE_ROWS: i64 = 32;
 
 /// Channels of every pipeline answer.
 pub mod channel {
@@ -410,9 +416,23 @@ impl Pipeline {
 
     /// [`Pipeline::columns`], computed.
     fn compute_columns(&self, blocks: Rect) -> Tile {
-        let (model, slope) = self.model_and_slope(Pipeline::model_rect(&blocks));
-        let finest = Tile::stack(&[&model.select(&[channel::ELEVATION]), &slope]);
-        let (mut elevation, smooth) = self.carve_blocks(&finest, blocks);
+        let relief = || {
+            let (model, slope) = self.model_and_slope(Pipeline::model_rect(&blocks));
+            let finest = Tile::stack(&[&model.select(&[channel::ELEVATION]), &slope]);
+            let (elevation, smooth) = self.carve_blocks(&finest, blocks);
+            (model, elevation, smooth)
+        };
+        let (model, mut elevation, smooth) = if blocks.area() >= REGION_QUERY_COLUMNS {
+            // The network's windows (the continent's flood is one thread's work, and the
+            // drained tiles wait on it) fill the threads that the relief's windows and
+            // carving leave idle, and the other way round. The same windows either way.
+            std::thread::scope(|scope| {
+                scope.spawn(|| self.rivers.prefetch(blocks, self.block_metres()));
+                relief()
+            })
+        } else {
+            relief()
+        };
         let water = self.water_columns(blocks, &mut elevation);
         let mut out = resample::bilinear(&model, BLOCK_RATIO, blocks);
         let lapse = self.settings.climate.lapse_rate_c_per_km as f32;
@@ -456,18 +476,32 @@ impl Pipeline {
         let b = self.block_metres();
         let octaves = octaves_between(2.0 * b, SHORTEST_ON_GRID_PIXELS * g);
         let n = blocks.area();
-        let mut out = cubic.data;
-        let mut lattice = Lattice::default();
-        let mut i = 0;
-        for z in blocks.y0..blocks.y1() {
-            for x in blocks.x0..blocks.x1() {
-                let gradient = (f64::from(fields.data[i]), f64::from(fields.data[n + i]));
-                let slope = f64::from(fields.data[2 * n + i]);
-                let (xm, zm) = ((x as f64 + 0.5) * b, (z as f64 + 0.5) * b);
-                out[i] += self.erosion.apply_with(&mut lattice, xm, zm, slope, gradient, octaves.clone()).height as f32;
-                i += 1;
+        // Each column is carved alone (the lattice only remembers hashes), so a region's rows
+        // are carved in bands on the engine's threads, a chunk's in one.
+        let carve = |rows: &(i64, i64)| {
+            let mut lattice = Lattice::default();
+            let mut band = Vec::with_capacity(((rows.1 - rows.0) * blocks.w) as usize);
+            for z in rows.0..rows.1 {
+                let first = ((z - blocks.y0) * blocks.w) as usize;
+                for (i, x) in (first..).zip(blocks.x0..blocks.x1()) {
+                    let gradient = (f64::from(fields.data[i]), f64::from(fields.data[n + i]));
+                    let slope = f64::from(fields.data[2 * n + i]);
+                    let (xm, zm) = ((x as f64 + 0.5) * b, (z as f64 + 0.5) * b);
+                    let carved = self.erosion.apply_with(&mut lattice, xm, zm, slope, gradient, octaves.clone());
+                    band.push(cubic.data[i] + carved.height as f32);
+                }
             }
-        }
+            band
+        };
+        let out = if n >= REGION_QUERY_COLUMNS {
+            let bands: Vec<(i64, i64)> = (blocks.y0..blocks.y1())
+                .step_by(CARVE_ROWS as usize)
+                .map(|z| (z, (z + CARVE_ROWS).min(blocks.y1())))
+                .collect();
+            self.engine.par_map(&bands, carve).concat()
+        } else {
+            carve(&(blocks.y0, blocks.y1()))
+        };
         (out, smooth.data)
     }
 

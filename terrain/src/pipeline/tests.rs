@@ -107,6 +107,22 @@ fn a_region_is_bit_identical_whatever_the_order_cache_and_threads() {
     assert_ne!(pipeline(78, 256, 1).columns(whole).data, reference.data, "the seed must matter");
 }
 
+#[test]
+fn a_region_sized_query_is_the_same_bits_as_its_chunks() {
+    // Large enough that its network is evaluated beside its relief and its carving is split
+    // into bands, the last one short.
+    let whole = Rect::new(-3_008, 7_008, 144, 160);
+    assert!(whole.area() >= super::REGION_QUERY_COLUMNS && whole.h % super::CARVE_ROWS != 0);
+    let region = pipeline(5, 256, 2).columns(whole);
+    let p = pipeline(5, 256, 1);
+    for y0 in (whole.y0..whole.y1()).step_by(16) {
+        for x0 in (whole.x0..whole.x1()).step_by(16) {
+            let chunk = Rect::new(y0, x0, 16, 16);
+            assert!(same(&p.columns(chunk), &region.crop(chunk)), "{chunk:?}");
+        }
+    }
+}
+
 fn at_scale(metres_per_block: f64) -> Pipeline {
     Pipeline::new(21, &TerrainSettings { metres_per_block, ..Default::default() })
 }
