@@ -45,7 +45,8 @@ const COARSE_TILE: i64 = 64;
 const BLOCK_RATIO: f64 = 1.0 / BLOCKS_PER_MODEL_PIXEL as f64;
 /// Block columns from which a query is a region, not a chunk: its drainage network is
 /// evaluated beside its relief, and its carving split over the engine's threads (a chunk's
-/// query runs on one of many chunk workers, which keep the threads busy already).
+/// query runs on one of many chunk workers, which keep the threads busy already). See
+/// [`Pipeline::splits`].
 const REGION_QUERY_COLUMNS: usize = 128 * 128;
 /// Rows of block columns carved per task when a region's carving is split.
 const CARVE_ROWS: i64 = 32;
@@ -414,6 +415,12 @@ impl Pipeline {
         self.column_cache.columns(blocks, |rect| self.compute_columns(rect))
     }
 
+    /// Whether a query over `blocks` is split over threads ([`REGION_QUERY_COLUMNS`]): only
+    /// a region-sized one, and only when the engine may use more than one thread.
+    fn splits(&self, blocks: Rect) -> bool {
+        blocks.area() >= REGION_QUERY_COLUMNS && self.engine.threads() > 1
+    }
+
     /// [`Pipeline::columns`], computed.
     fn compute_columns(&self, blocks: Rect) -> Tile {
         let relief = || {
@@ -422,7 +429,7 @@ impl Pipeline {
             let (elevation, smooth) = self.carve_blocks(&finest, blocks);
             (model, elevation, smooth)
         };
-        let (model, mut elevation, smooth) = if blocks.area() >= REGION_QUERY_COLUMNS {
+        let (model, mut elevation, smooth) = if self.splits(blocks) {
             // The network's windows (the continent's flood is one thread's work, and the
             // drained tiles wait on it) fill the threads that the relief's windows and
             // carving leave idle, and the other way round. The same windows either way.
@@ -493,7 +500,7 @@ impl Pipeline {
             }
             band
         };
-        let out = if n >= REGION_QUERY_COLUMNS {
+        let out = if self.splits(blocks) {
             let bands: Vec<(i64, i64)> = (blocks.y0..blocks.y1())
                 .step_by(CARVE_ROWS as usize)
                 .map(|z| (z, (z + CARVE_ROWS).min(blocks.y1())))
