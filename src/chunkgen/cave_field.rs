@@ -60,6 +60,45 @@ pub fn density(seed: u64, x: i64, y: i64, z: i64) -> f32 {
     (cavern - CAVERN_AT).max(tunnel)
 }
 
+/// [`density`] at the lattice point (`x`, `y`, `z`) (multiples of [`LATTICE`], [`LATTICE_Y`]
+/// and [`LATTICE`]), remembered per thread. The caves pass computes a chunk's lattice, and the
+/// surface, tree and plant decisions after it ask [`field`] about the same points again
+/// (every column of an entrance patch, eight corners each): without the memo that was as
+/// much hashing again as the carving's. The same bits as [`density`], whatever the memo holds.
+pub fn lattice_density(seed: u64, x: i64, y: i64, z: i64) -> f32 {
+    debug_assert!(x % LATTICE == 0 && y % LATTICE_Y == 0 && z % LATTICE == 0, "({x}, {y}, {z}) is off the lattice");
+    let key = (i32::try_from(x / LATTICE), i32::try_from(y / LATTICE_Y), i32::try_from(z / LATTICE));
+    let (Ok(lx), Ok(ly), Ok(lz)) = key else { return density(seed, x, y, z) };
+    // A chunk's lattice (5 × 5 points a row, up to 49 rows) and its neighbours' shared edges
+    // fall on distinct slots.
+    let slot = ((lx & 7) | (lz & 7) << 3 | (ly & 63) << 6) as usize;
+    MEMO.with_borrow_mut(|memo| {
+        let entry = &mut memo[slot];
+        if entry.seed != seed || (entry.x, entry.y, entry.z) != (lx, ly, lz) {
+            *entry = Remembered { seed, x: lx, y: ly, z: lz, density: density(seed, x, y, z) };
+        }
+        entry.density
+    })
+}
+
+/// One remembered lattice density (coordinates in lattice units).
+#[derive(Clone, Copy)]
+struct Remembered {
+    seed: u64,
+    x: i32,
+    y: i32,
+    z: i32,
+    density: f32,
+}
+
+thread_local! {
+    /// The lattice densities each thread computed last, by slot ([`lattice_density`]). Empty
+    /// slots hold `x = i32::MIN`, which no lattice point within `i32` has.
+    static MEMO: std::cell::RefCell<Box<[Remembered; 4096]>> = std::cell::RefCell::new(Box::new(
+        [Remembered { seed: 0, x: i32::MIN, y: 0, z: 0, density: 0.0 }; 4096],
+    ));
+}
+
 /// The density inside a lattice cell from its eight corners (x fastest, then z, then y:
 /// `[x0z0y0, x1z0y0, x0z1y0, x1z1y0, x0z0y1, …]`) at fractions `tx`, `ty`, `tz` of the cell.
 /// The one formula both the pass and [`field`] use, so they agree bit for bit.
@@ -75,7 +114,7 @@ pub fn interpolate(c: &[f32; 8], tx: f32, ty: f32, tz: f32) -> f32 {
 pub fn field(seed: u64, x: i64, y: i64, z: i64) -> f32 {
     let (cx, cy, cz) =
         (x.div_euclid(LATTICE) * LATTICE, y.div_euclid(LATTICE_Y) * LATTICE_Y, z.div_euclid(LATTICE) * LATTICE);
-    let d = |i: i64, j: i64, k: i64| density(seed, cx + i * LATTICE, cy + j * LATTICE_Y, cz + k * LATTICE);
+    let d = |i: i64, j: i64, k: i64| lattice_density(seed, cx + i * LATTICE, cy + j * LATTICE_Y, cz + k * LATTICE);
     let corners = [d(0, 0, 0), d(1, 0, 0), d(0, 0, 1), d(1, 0, 1), d(0, 1, 0), d(1, 1, 0), d(0, 1, 1), d(1, 1, 1)];
     let t = |v: i64, l: i64| v.rem_euclid(l) as f32 / l as f32;
     interpolate(&corners, t(x, LATTICE), t(y, LATTICE_Y), t(z, LATTICE))
@@ -127,4 +166,31 @@ pub fn may_open(seed: u64, columns: &Columns, x: i64, z: i64) -> bool {
     // Cheap test first: almost all ground lies outside entrance patches.
     let widen = widening(seed, x, z);
     widen > 0.0 && field(seed, x, i64::from(columns.surface_y(x, z)), z) + widen > 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn remembered_densities_are_the_densities() {
+        // Points that share slots (8 lattice units apart across, 64 up), two seeds, visited
+        // twice in an order that evicts: every answer is the density itself.
+        let points: Vec<(i64, i64, i64)> = (0..400)
+            .map(|i: i64| {
+                ((i % 11 - 5) * 8 * LATTICE, (i % 7 - 3) * 64 * LATTICE_Y + (i % 3) * LATTICE_Y, (i / 11) * LATTICE)
+            })
+            .collect();
+        for _ in 0..2 {
+            for &(x, y, z) in &points {
+                for seed in [3, 4] {
+                    assert_eq!(
+                        lattice_density(seed, x, y, z).to_bits(),
+                        density(seed, x, y, z).to_bits(),
+                        "({x}, {y}, {z})"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -25,18 +25,20 @@ impl Generator {
     /// (empty for bare ground), as [`chunk`](Self::chunk) places them where no tree stands.
     pub fn plant_blocks(&self, rules: &BiomeRules, x: i64, z: i64) -> Vec<BlockState> {
         let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
-        let trees = self.trees(rules, &columns, x, z, 1);
-        self.plant_at(rules, &columns, &trees, x, z).map_or_else(Vec::new, |(_, p)| p.blocks())
+        let biome = |x, z| self.surface_biome(rules, &columns, x, z);
+        let trees = self.trees(rules, &columns, &biome, x, z, 1);
+        self.plant_at(rules, &columns, &biome, &trees, x, z).map_or_else(Vec::new, |(_, p)| p.blocks())
     }
 
     /// The plant of column (`x`, `z`) and the Y of its lowest block, or `None`. `trees` must
-    /// hold every tree rooted within `REACH` of the column and `columns` cover
-    /// [`tree_rect`] of it. Cacti grow only where their four neighbours stay air at every
+    /// hold every tree rooted within `REACH` of the column, `columns` cover [`tree_rect`] of
+    /// it and `biome` answer as [`surface_biome`](Self::surface_biome) does. Cacti grow only where their four neighbours stay air at every
     /// height they reach: lower ground, no plant and no tree nearby.
-    pub(super) fn plant_at(
+    pub(super) fn plant_at<'r>(
         &self,
-        rules: &BiomeRules,
+        rules: &'r BiomeRules,
         columns: &Columns,
+        biome: &dyn Fn(i64, i64) -> &'r str,
         trees: &[Tree],
         x: i64,
         z: i64,
@@ -50,7 +52,7 @@ impl Generator {
             {
                 return None;
             }
-            let biome = self.surface_biome(rules, columns, x, z);
+            let biome = biome(x, z);
             let ground = self.ground_at(rules, columns, biome, x, z);
             if ground.top.is_liquid() {
                 return None;
@@ -78,19 +80,28 @@ impl Generator {
     /// True when no tree stands on or over column (`x`, `z`) (a place to put a player).
     pub fn clear_of_trees(&self, rules: &BiomeRules, x: i64, z: i64) -> bool {
         let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
-        self.trees(rules, &columns, x, z, 1)
+        self.trees(rules, &columns, &|x, z| self.surface_biome(rules, &columns, x, z), x, z, 1)
             .iter()
             .all(|t| (t.x - x).abs() > trees::REACH || (t.z - z).abs() > trees::REACH)
     }
 
     /// Every tree rooted within reach of the `size`×`size` square at (`x0`, `z0`), in global
-    /// order. `columns` must cover [`tree_rect`] of the square.
-    pub(super) fn trees(&self, rules: &BiomeRules, columns: &Columns, x0: i64, z0: i64, size: i64) -> Vec<Tree> {
+    /// order. `columns` must cover [`tree_rect`] of the square, and `biome` answer as
+    /// [`surface_biome`](Self::surface_biome) does.
+    pub(super) fn trees<'r>(
+        &self,
+        rules: &'r BiomeRules,
+        columns: &Columns,
+        biome: &dyn Fn(i64, i64) -> &'r str,
+        x0: i64,
+        z0: i64,
+        size: i64,
+    ) -> Vec<Tree> {
         debug_assert!(columns.rect().contains_rect(&tree_rect(x0, z0, size)));
         let v = &self.vertical;
         let mut trees = Vec::new();
         for (x, z, chance, draw) in trees::candidate_roots(self.seed, x0, z0, size) {
-            let biome = self.surface_biome(rules, columns, x, z);
+            let biome = biome(x, z);
             let Some(vegetation) = rules.vegetation(biome) else { continue };
             if chance >= vegetation.trees {
                 continue;

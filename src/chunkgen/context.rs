@@ -3,7 +3,7 @@
 
 use crate::biome::BiomeRules;
 
-use super::cells::CELL;
+use super::cells::{self, CELL};
 use super::columns::Columns;
 use super::{BiomePalette, Generator, Vertical, CHUNK};
 
@@ -65,6 +65,29 @@ impl<'a> ChunkContext<'a> {
     /// Biome cells per column of cells (the world's height / 4).
     pub fn cells_y(&self) -> usize {
         (self.vertical().height / CELL as i32) as usize
+    }
+
+    /// The biome of the cell holding column (`x`, `z`)'s ground block, as
+    /// [`Generator::surface_biome`] decides it: from the cells the columns pass decided for a
+    /// column of this chunk (the vegetation and snow passes ask for every column, and
+    /// deciding a cell's biome anew each time was a tenth of a chunk's time), else anew.
+    pub fn surface_biome(&self, x: i64, z: i64) -> &'a str {
+        let columns = self.columns();
+        let (lx, lz) = (x - self.x0, z - self.z0);
+        let v = self.vertical();
+        let cell_y = (cells::cell_centre_y(columns.surface_y(x, z)) - v.min_y).div_euclid(CELL as i32);
+        // (Passes tested alone run without the columns pass's cells.)
+        let decided = self.biomes.len() == 16 * self.cells_y();
+        if decided
+            && (0..CHUNK).contains(&lx)
+            && (0..CHUNK).contains(&lz)
+            && (0..self.cells_y() as i32).contains(&cell_y)
+        {
+            let cell = ((lz / CELL) * 4 + lx / CELL) as usize;
+            self.biomes[cell * self.cells_y() + cell_y as usize]
+        } else {
+            self.generator.surface_biome(self.rules, columns, x, z)
+        }
     }
 
     /// Every column of the chunk: (chunk-local x, chunk-local z, global x, global z), rows of

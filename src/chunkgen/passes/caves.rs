@@ -8,7 +8,7 @@ use valence::prelude::{BlockState, Chunk};
 
 use crate::chunkgen::Blocks;
 
-use crate::chunkgen::cave_field::{ceiling, density, interpolate, widening, LATTICE, LATTICE_Y, MOUTH_DEPTH};
+use crate::chunkgen::cave_field::{ceiling, interpolate, lattice_density, widening, LATTICE, LATTICE_Y, MOUTH_DEPTH};
 use crate::chunkgen::{ChunkContext, CHUNK};
 
 /// Carved blocks at this Y and below are lava.
@@ -42,7 +42,7 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
         for k in 0..n {
             for i in 0..n {
                 let (x, z) = (ctx.x0 + i as i64 * LATTICE, ctx.z0 + k as i64 * LATTICE);
-                lattice[(j * n + k) * n + i] = density(seed, x, ly * LATTICE_Y, z);
+                lattice[(j * n + k) * n + i] = lattice_density(seed, x, ly * LATTICE_Y, z);
             }
         }
     }
@@ -127,7 +127,7 @@ fn carve_cell(
 mod tests {
     use super::super::testing;
     use super::*;
-    use crate::chunkgen::cave_field::{entrance, field, opens, LAND_SEAL};
+    use crate::chunkgen::cave_field::{density, entrance, field, opens, LAND_SEAL};
     use crate::terrain::Rect;
 
     /// A chunk of rock up to `ground(x)` with the sea pass run, then this pass.

@@ -186,11 +186,19 @@ fn place_vein(chunk: &mut Blocks, x0: i64, z0: i64, min_y: i32, ore: &Vein, salt
     let dys = (1 - sy + min_y).max(-r)..=(i64::from(chunk.height()) - 1 - sy + min_y).min(r);
     let dzs = (z0 - sz).max(-r)..=(z0 + CHUNK - 1 - sz).min(r);
     let dxs = (x0 - sx).max(-r)..=(x0 + CHUNK - 1 - sx).min(r);
+    // No jitter lets in a block farther than this (blocks², with a block to spare for
+    // rounding): each row is visited only across the ball, about half its bounding box.
+    let limit = r2 + JITTER * 0.5 + 1.0;
     for dy in dys {
         let ly = sy + dy - min_y;
         for dz in dzs.clone() {
             let lz = sz + dz - z0;
-            for dx in dxs.clone() {
+            let left = limit - (dy * dy + dz * dz) as f32;
+            if left < 0.0 {
+                continue;
+            }
+            let half = left.sqrt() as i64;
+            for dx in (*dxs.start()).max(-half)..=(*dxs.end()).min(half) {
                 let lx = sx + dx - x0;
                 if !in_vein(salt, r2, (dx, dy, dz)) {
                     continue;

@@ -24,10 +24,10 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     if !ctx.biomes.iter().any(|b| snowy(b)) {
         return;
     }
-    let (g, v, columns) = (ctx.generator, *ctx.vertical(), ctx.columns());
+    let (v, columns) = (*ctx.vertical(), ctx.columns());
     let height = chunk.height() as i32;
     for (lx, lz, x, z) in ctx.each_column() {
-        if columns.is_wet(x, z) || !snowy(g.surface_biome(ctx.rules, columns, x, z)) {
+        if columns.is_wet(x, z) || !snowy(ctx.surface_biome(x, z)) {
             continue;
         }
         let ground = columns.surface_y(x, z) - v.min_y;

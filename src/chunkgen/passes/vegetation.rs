@@ -11,12 +11,13 @@ use crate::chunkgen::{ChunkContext, CHUNK};
 /// Places every tree reaching into the chunk, then the plants.
 pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let (g, v, columns) = (ctx.generator, *ctx.vertical(), ctx.columns());
-    let trees = g.trees(ctx.rules, columns, ctx.x0, ctx.z0, CHUNK);
+    let biome = |x, z| ctx.surface_biome(x, z);
+    let trees = g.trees(ctx.rules, columns, &biome, ctx.x0, ctx.z0, CHUNK);
     trees::place(chunk, &trees, ctx.x0, ctx.z0, v.min_y);
     // Plants last, and only where every block they need is still air (tree blocks in a
     // column do not depend on the chunk, so neither does this).
     for (lx, lz, x, z) in ctx.each_column() {
-        let Some((base_y, plant)) = g.plant_at(ctx.rules, columns, &trees, x, z) else { continue };
+        let Some((base_y, plant)) = g.plant_at(ctx.rules, columns, &biome, &trees, x, z) else { continue };
         let blocks = plant.blocks();
         let ys = (base_y..).take(blocks.len()).map(|y| (y - v.min_y) as u32);
         if ys.clone().all(|ly| chunk.block_state(lx, ly, lz).is_air()) {
