@@ -38,9 +38,19 @@ fn nbt_like(len: usize) -> Vec<u8> {
     out
 }
 
-/// Stored "zlib" bytes that are incompressible noise of `sectors` sectors once framed.
+/// Stored "zlib" bytes of incompressible noise that fill `sectors` sectors once framed (the
+/// compressor's fast level may enlarge noise by a few per cent: the noise is shortened until
+/// it fits).
 fn payload(seed: u64, sectors: usize) -> Vec<u8> {
-    compress(&noise(seed, sectors * 4096 - 64))
+    let mut len = sectors * 4096 - 64;
+    loop {
+        let bytes = compress(&noise(seed, len));
+        if bytes.len() + 5 <= sectors * 4096 {
+            assert!(bytes.len() + 5 > (sectors - 1) * 4096, "{sectors} sectors");
+            return bytes;
+        }
+        len -= 64;
+    }
 }
 
 fn new_region(dir: &Path) -> (PathBuf, RegionFile) {

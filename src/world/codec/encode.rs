@@ -148,20 +148,17 @@ impl Encoder {
             w.end();
             return;
         }
-        let mut last_raw = NO_SLOT; // No block state has this raw id.
-        let mut last_slot = 0u16;
         for (index, &raw) in self.indices.iter_mut().zip(section) {
-            // Neighbouring blocks are mostly the same: skip the table then.
-            if raw != last_raw {
-                last_raw = raw;
-                last_slot = self.slots[usize::from(raw)];
-                if last_slot == NO_SLOT {
-                    last_slot = self.palette.len() as u16;
-                    self.slots[usize::from(raw)] = last_slot;
-                    self.palette.push(raw);
-                }
+            // A table lookup for every block, and a branch only for a block new to the
+            // section (a handful a section): comparing with the previous block first was a
+            // misprediction at every change of block among ores, caves and ground.
+            let mut slot = self.slots[usize::from(raw)];
+            if slot == NO_SLOT {
+                slot = self.palette.len() as u16;
+                self.slots[usize::from(raw)] = slot;
+                self.palette.push(raw);
             }
-            *index = last_slot;
+            *index = slot;
         }
 
         w.tag(tag::COMPOUND, "block_states");
