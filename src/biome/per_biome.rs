@@ -11,7 +11,7 @@ use toml::{Spanned, Value};
 use valence::prelude::{BlockKind, BlockState};
 
 use super::error::{line_of, BiomeError, Location, Problem};
-use super::names::{overworld_biome, suggest_biome, OVERWORLD_BIOMES};
+use super::names::{overworld_biome, overworld_index, suggest_biome, OVERWORLD_BIOMES};
 
 /// One file's tables of one kind, as TOML gives them (keys keep their places).
 pub(crate) type RawTables = BTreeMap<Spanned<String>, Spanned<Body>>;
@@ -37,8 +37,7 @@ impl<T> Default for Table<T> {
 impl<T> Table<T> {
     /// The value for `biome`; `None` where no table names it.
     pub(crate) fn get(&self, biome: &str) -> Option<&T> {
-        let i = OVERWORLD_BIOMES.binary_search(&biome).ok()?;
-        self.by_biome.get(i)?.as_ref()
+        self.by_biome.get(overworld_index(biome)?)?.as_ref()
     }
 }
 

@@ -182,6 +182,30 @@ impl Table {
         self.bounds.iter().position(|b| b.contains(&v))
     }
 
+    /// The rules that can match conditions equal to `c` on every lane but temperature and
+    /// elevation, in order: those whose box holds `c` on all the other lanes.
+    pub(crate) fn candidates_varying_height(&self, c: &Conditions) -> Vec<usize> {
+        let v = c.lanes();
+        let fixed = |b: &Bounds| {
+            (0..LANES)
+                .filter(|&i| i != Axis::Temperature.lane() && i != Axis::Elevation.lane())
+                .all(|i| b.lo[i] <= v[i] && v[i] < b.hi[i])
+        };
+        (0..self.bounds.len()).filter(|&i| fixed(&self.bounds[i])).collect()
+    }
+
+    /// [`biome`](Self::biome) of `c` among `candidates` only (see
+    /// [`candidates_varying_height`](Self::candidates_varying_height)): a rule left out
+    /// fails on a lane `c` shares, so the first match among the rest is the first of all.
+    #[inline]
+    pub(crate) fn biome_among(&self, candidates: &[usize], c: &Conditions) -> &'static str {
+        let v = c.lanes();
+        match candidates.iter().find(|&&i| self.bounds[i].contains(&v)) {
+            Some(&i) => self.biomes[i],
+            None => self.fallback,
+        }
+    }
+
     /// The biome of the first matching rule, or the fallback.
     #[inline]
     pub(crate) fn biome(&self, c: &Conditions) -> &'static str {

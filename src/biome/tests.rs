@@ -446,3 +446,40 @@ fn a_hundred_thousand_lookups_stay_linear() {
     assert_eq!(counts.values().sum::<u32>(), 100_000);
     assert!(counts.len() > 20, "{counts:?}");
 }
+
+#[test]
+fn a_column_of_cells_gets_the_biomes_the_whole_table_gives() {
+    let rules = BiomeRules::load_dir(&Path::new(env!("CARGO_MANIFEST_DIR")).join("biomes")).unwrap();
+    let mut h = 3u64;
+    let mut unit = move || {
+        h = h.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (h >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let (mut cells, mut biomes) = (0, std::collections::BTreeSet::new());
+    for _ in 0..3000 {
+        let ground = Conditions {
+            temperature_c: -30.0 + 65.0 * unit(),
+            seasonality_c: 40.0 * unit(),
+            precipitation_mm: 3000.0 * unit(),
+            variability_pct: 60.0 * unit(),
+            elevation_m: -500.0 + 4500.0 * unit(),
+            surface_m: -500.0 + 4500.0 * unit(),
+            slope_deg: 40.0 * unit(),
+            water: WaterBody::ALL[(unit() * WaterBody::ALL.len() as f32) as usize % WaterBody::ALL.len()],
+            river_distance_m: 700.0 * unit(),
+        };
+        let column = rules.over(&ground);
+        // Up the air over it: higher and colder.
+        for k in 0..40 {
+            let c = Conditions {
+                elevation_m: ground.elevation_m + 150.0 * k as f32,
+                temperature_c: ground.temperature_c - 0.9 * k as f32,
+                ..ground
+            };
+            assert_eq!(column.biome(&c), rules.biome(&c), "{c:?}");
+            biomes.insert(rules.biome(&c));
+            cells += 1;
+        }
+    }
+    assert!(cells == 120_000 && biomes.len() > 20, "{} biomes met", biomes.len());
+}

@@ -78,6 +78,15 @@ impl Blocks {
     }
 }
 
+impl Blocks {
+    /// The 256 blocks at height `y` (counted from the chunk's floor), index `z·16 + x`: for
+    /// passes that fill layers rather than columns.
+    pub fn layer_mut(&mut self, y: u32) -> &mut [BlockState] {
+        let start = index(0, y, 0);
+        &mut self.states[start..start + 256]
+    }
+}
+
 /// The one value every entry of `values` holds, if they all hold the same.
 fn uniform<T: PartialEq>(values: &[T]) -> Option<&T> {
     let first = values.first()?;

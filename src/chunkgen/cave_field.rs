@@ -137,6 +137,12 @@ pub fn widening(seed: u64, x: i64, z: i64) -> f32 {
 pub fn ceiling(seed: u64, columns: &Columns, x: i64, z: i64) -> i32 {
     let near_water =
         (-SHORE_REACH..=SHORE_REACH).any(|dz| (-SHORE_REACH..=SHORE_REACH).any(|dx| columns.is_wet(x + dx, z + dz)));
+    ceiling_near(seed, columns, x, z, near_water)
+}
+
+/// [`ceiling`], told whether any column within [`SHORE_REACH`] is wet (the caves pass finds
+/// that for a whole chunk at once).
+pub fn ceiling_near(seed: u64, columns: &Columns, x: i64, z: i64, near_water: bool) -> i32 {
     let ground = columns.surface_y(x, z);
     if near_water {
         let lowest = (-SHORE_REACH..=SHORE_REACH)

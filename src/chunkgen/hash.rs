@@ -24,9 +24,15 @@ pub fn value_noise(seed: u64, salt: u64, x: i64, z: i64, scale: i64) -> f32 {
     let (cx, cz) = (x.div_euclid(scale), z.div_euclid(scale));
     let fx = smooth(x.rem_euclid(scale) as f32 / scale as f32);
     let fz = smooth(z.rem_euclid(scale) as f32 / scale as f32);
-    let at = |dx: i64, dz: i64| unit3(seed, salt, cx + dx, 0, cz + dz);
-    let top = at(0, 0) + (at(1, 0) - at(0, 0)) * fx;
-    let bottom = at(0, 1) + (at(1, 1) - at(0, 1)) * fx;
+    // [`unit3`] of the four corners (at y = 0), sharing the hash's x and y steps between the
+    // corners of one x: 8 mixes instead of 12, the same bits.
+    let base = seed ^ salt.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let step = |h: u64, v: i64| mix(h ^ (v as u64).wrapping_mul(0xD6E8_FEB8_6659_FD93));
+    let unit = |h: u64| (h >> 40) as f32 / (1u64 << 24) as f32;
+    let (h0, h1) = (step(step(base, cx), 0), step(step(base, cx + 1), 0));
+    let (a00, a10, a01, a11) = (unit(step(h0, cz)), unit(step(h1, cz)), unit(step(h0, cz + 1)), unit(step(h1, cz + 1)));
+    let top = a00 + (a10 - a00) * fx;
+    let bottom = a01 + (a11 - a01) * fx;
     top + (bottom - top) * fz
 }
 
@@ -104,6 +110,20 @@ mod tests {
         for i in -50..50 {
             let (x, y, z) = (i as f64 * 0.37, -(i as f64) * 1.13 + 0.5, i as f64 * i as f64 * 0.011 - 7.0);
             assert_eq!(value_noise3(5, 9, x, y, z).to_bits(), plain(x, y, z).to_bits(), "({x}, {y}, {z})");
+        }
+    }
+
+    #[test]
+    fn value_noise_interpolates_the_hashed_corners() {
+        for (x, z) in [(0i64, 0i64), (-1, 7), (33, -65), (-1000, 999), (17, 16)] {
+            let scale = 8;
+            let (cx, cz) = (x.div_euclid(scale), z.div_euclid(scale));
+            let fx = smooth(x.rem_euclid(scale) as f32 / scale as f32);
+            let fz = smooth(z.rem_euclid(scale) as f32 / scale as f32);
+            let at = |dx: i64, dz: i64| unit3(4, 6, cx + dx, 0, cz + dz);
+            let top = at(0, 0) + (at(1, 0) - at(0, 0)) * fx;
+            let bottom = at(0, 1) + (at(1, 1) - at(0, 1)) * fx;
+            assert_eq!(value_noise(4, 6, x, z, scale).to_bits(), (top + (bottom - top) * fz).to_bits(), "({x}, {z})");
         }
     }
 

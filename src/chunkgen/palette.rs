@@ -3,6 +3,8 @@
 use std::collections::HashMap;
 
 use valence::prelude::{BiomeId, BiomeRegistry};
+
+use crate::biome::{overworld_index, OVERWORLD_BIOMES};
 use valence::registry::{RegistryCodec, RegistryIdx};
 
 /// Every biome name Minecraft 1.20.1 knows (`"minecraft:plains"`, …), from the registry
@@ -15,6 +17,9 @@ pub fn vanilla_biome_names() -> Vec<String> {
 #[derive(Clone, Debug)]
 pub struct BiomePalette {
     ids: HashMap<String, BiomeId>,
+    /// The id of every overworld biome, indexed like [`OVERWORLD_BIOMES`] (a lookup without
+    /// hashing a name, for every biome cell of every chunk).
+    overworld: Vec<BiomeId>,
     /// Name of each id, by index.
     names: Vec<String>,
     fallback: BiomeId,
@@ -29,7 +34,14 @@ impl BiomePalette {
             names[id.to_index()] = name.as_str().to_string();
             ids.insert(name.as_str().to_string(), id);
         }
-        BiomePalette { ids, names, fallback: BiomeId::DEFAULT }
+        BiomePalette::new(ids, names)
+    }
+
+    /// The palette of `ids`, whose names by index are `names`.
+    fn new(ids: HashMap<String, BiomeId>, names: Vec<String>) -> BiomePalette {
+        let fallback = BiomeId::DEFAULT;
+        let overworld = OVERWORLD_BIOMES.iter().map(|&n| ids.get(n).copied().unwrap_or(fallback)).collect();
+        BiomePalette { ids, overworld, names, fallback }
     }
 
     /// The palette of valence's default biome registry without a running server: vanilla's
@@ -41,7 +53,7 @@ impl BiomePalette {
             names.swap(0, i);
         }
         let ids = names.iter().enumerate().map(|(i, n)| (n.clone(), BiomeId::from_index(i))).collect();
-        BiomePalette { ids, names, fallback: BiomeId::DEFAULT }
+        BiomePalette::new(ids, names)
     }
 
     /// Biome names indexed by id.
@@ -51,7 +63,10 @@ impl BiomePalette {
 
     /// The id of biome `name`, or the fallback when the registry lacks it.
     pub fn id(&self, name: &str) -> BiomeId {
-        self.ids.get(name).copied().unwrap_or(self.fallback)
+        match overworld_index(name) {
+            Some(i) => self.overworld[i],
+            None => self.ids.get(name).copied().unwrap_or(self.fallback),
+        }
     }
 
     /// True when the registry holds `name`.

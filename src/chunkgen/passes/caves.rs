@@ -8,7 +8,10 @@ use valence::prelude::{BlockState, Chunk};
 
 use crate::chunkgen::Blocks;
 
-use crate::chunkgen::cave_field::{ceiling, interpolate, lattice_density, widening, LATTICE, LATTICE_Y, MOUTH_DEPTH};
+use crate::chunkgen::cave_field::{
+    ceiling_near, interpolate, lattice_density, widening, LATTICE, LATTICE_Y, MOUTH_DEPTH, SHORE_REACH,
+};
+use crate::chunkgen::columns::Columns;
 use crate::chunkgen::{ChunkContext, CHUNK};
 
 /// Carved blocks at this Y and below are lava.
@@ -22,7 +25,11 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let columns = ctx.columns();
     // The highest Y each column may be carved to.
     let seed = ctx.seed();
-    let ceiling: Vec<i32> = ctx.each_column().map(|(_, _, x, z)| ceiling(seed, columns, x, z)).collect();
+    let near = near_water(columns, ctx.x0, ctx.z0);
+    let ceiling: Vec<i32> = ctx
+        .each_column()
+        .map(|(lx, lz, x, z)| ceiling_near(seed, columns, x, z, near[(lz * 16 + lx) as usize]))
+        .collect();
     // Entrance patches widen the caves near the ground: from this Y up, by this much.
     let mouths: Vec<(i32, f32)> =
         ctx.each_column().map(|(_, _, x, z)| (columns.surface_y(x, z) - MOUTH_DEPTH, widening(seed, x, z))).collect();
@@ -71,6 +78,20 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
             }
         }
     }
+}
+
+/// For every column of the chunk at (`x0`, `z0`) (index `z·16 + x`), whether a column within
+/// [`SHORE_REACH`] is wet: the wet columns widened along x, then along z — 14 looks a column
+/// instead of the 49 of asking each column's square.
+fn near_water(columns: &Columns, x0: i64, z0: i64) -> Vec<bool> {
+    let (r, n) = (SHORE_REACH, CHUNK as usize);
+    let rows = (z0 - r..z0 + CHUNK + r)
+        .map(|z| (x0..x0 + CHUNK).map(move |x| (x - r..=x + r).any(|x| columns.is_wet(x, z))).collect::<Vec<_>>());
+    let rows: Vec<Vec<bool>> = rows.collect();
+    (0..n)
+        .flat_map(|lz| (0..n).map(move |lx| (lz, lx)))
+        .map(|(lz, lx)| rows[lz..=lz + 2 * r as usize].iter().any(|row| row[lx]))
+        .collect()
 }
 
 /// What limits and widens the carving of each column of the chunk (index `z·16 + x`).
@@ -142,6 +163,32 @@ mod tests {
         super::super::water::run(&mut ctx, &mut chunk);
         run(&mut ctx, &mut chunk);
         (chunk, v)
+    }
+
+    #[test]
+    fn the_chunk_s_shore_test_is_each_column_s() {
+        let g = testing::generator();
+        // A coast across the chunk, diagonal, and a pond: columns near water and far from it.
+        let columns = testing::columns(&g, Rect::new(-5, 27, 26, 26), |x, z| {
+            let pond = (x - 40).pow(2) + (z - 9).pow(2) < 4;
+            (if pond { -30.0 } else { (x + z - 45) as f32 * 4.0 }, 10.0)
+        });
+        let near = near_water(&columns, 32, 0);
+        let (mut wet, mut dry) = (0, 0);
+        for lz in 0..16 {
+            for lx in 0..16 {
+                let (x, z) = (32 + lx, lz);
+                let each = (-SHORE_REACH..=SHORE_REACH)
+                    .any(|dz| (-SHORE_REACH..=SHORE_REACH).any(|dx| columns.is_wet(x + dx, z + dz)));
+                assert_eq!(near[(lz * 16 + lx) as usize], each, "({x}, {z})");
+                if each {
+                    wet += 1
+                } else {
+                    dry += 1
+                }
+            }
+        }
+        assert!(wet > 20 && dry > 20, "{wet} near water, {dry} not");
     }
 
     #[test]

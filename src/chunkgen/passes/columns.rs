@@ -1,7 +1,7 @@
 //! The columns pass: asks the pipeline for the chunk's columns and decides the biome of every
 //! 4×4×4 cell, writing the biomes into the chunk.
 
-use valence::prelude::Chunk;
+use valence::prelude::{BiomeId, Chunk};
 
 use crate::chunkgen::Blocks;
 
@@ -21,11 +21,18 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     ctx.biomes = biomes(ctx, &columns);
     ctx.columns = Some(columns);
     let cells_y = ctx.cells_y();
+    // Cells up a column mostly share a biome: look its id up once per run of them.
+    let mut last: Option<(&str, BiomeId)> = None;
     for cz in 0..4 {
         for cx in 0..4 {
             for cy in 0..cells_y {
                 let name = ctx.biomes[(cz * 4 + cx) * cells_y + cy];
-                chunk.set_biome(cx as u32, cy as u32, cz as u32, ctx.palette.id(name));
+                let id = match last {
+                    Some((n, id)) if std::ptr::eq(n, name) => id,
+                    _ => ctx.palette.id(name),
+                };
+                last = Some((name, id));
+                chunk.set_biome(cx as u32, cy as u32, cz as u32, id);
             }
         }
     }
@@ -44,12 +51,13 @@ fn biomes<'r>(ctx: &ChunkContext<'r>, columns: &Columns) -> Vec<&'r str> {
             // it differ only in height and temperature.
             let conditions = cells::ground_conditions(columns, sx, sz);
             let ground = ctx.rules.biome(&conditions);
+            let air = ctx.rules.over(&conditions);
             for cy in 0..cells_y {
                 let centre = v.min_y + cy as i32 * CELL as i32 + CELL as i32 / 2;
                 names.push(if centre <= ground_top {
                     ground
                 } else {
-                    ctx.rules.biome(&cells::at_height(&conditions, ground_top, v, lapse, centre))
+                    air.biome(&cells::at_height(&conditions, ground_top, v, lapse, centre))
                 });
             }
         }

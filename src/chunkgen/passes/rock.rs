@@ -52,9 +52,25 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
         }
         first_free_y = hi + 1;
     }
-    for (lx, lz, x, z) in ctx.each_column() {
-        for y in first_free_y..=columns.surface_y(x, z) {
-            chunk.set_block_state(lx, (y - v.min_y) as u32, lz, rock_at(seed, v.min_y, x, y, z));
+    // Then layer by layer up to the highest ground: a layer clear of both ragged boundaries
+    // is stone in every column whose ground reaches it (written along the layer, not up each
+    // column, which strides through memory).
+    let surface: Vec<i32> = ctx.each_column().map(|(_, _, x, z)| columns.surface_y(x, z)).collect();
+    let top = surface.iter().copied().max().unwrap_or(v.min_y);
+    for y in first_free_y..=top {
+        let ly = (y - v.min_y) as u32;
+        if y >= DEEPSLATE_TOP && y - v.min_y >= BEDROCK_LAYERS {
+            for (block, &ground) in chunk.layer_mut(ly).iter_mut().zip(&surface) {
+                if y <= ground {
+                    *block = BlockState::STONE;
+                }
+            }
+        } else {
+            for ((lx, lz, x, z), &ground) in ctx.each_column().zip(&surface) {
+                if y <= ground {
+                    chunk.set_block_state(lx, ly, lz, rock_at(seed, v.min_y, x, y, z));
+                }
+            }
         }
     }
 }
