@@ -11,9 +11,6 @@ use crate::chunkgen::Blocks;
 use crate::chunkgen::hash::unit3;
 use crate::chunkgen::ChunkContext;
 
-/// Deepest filler any ground asks for, plus the top block: sections entirely below this many
-/// blocks under the lowest surface of a chunk are plain rock.
-pub const MAX_GROUND_DEPTH: i32 = 16;
 /// Blocks over the floor bedrock reaches: the floor itself always, each block above it less
 /// often, none this high (vanilla's `bedrock_floor` gradient).
 pub const BEDROCK_LAYERS: i32 = 5;
@@ -28,47 +25,36 @@ const SALT_DEEPSLATE: u64 = 0x6465_6570;
 pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
     let (v, seed) = (*ctx.vertical(), ctx.seed());
     let columns = ctx.columns();
-    let min_surface = ctx.each_column().map(|(_, _, x, z)| columns.surface_y(x, z)).min().unwrap_or(v.min_y);
-    // Whole sections of rock below every column's ground: one block throughout where the
-    // section lies clear of both ragged boundaries, filled wholesale (much faster than block
-    // by block); the rest block by block.
-    let rock_top = min_surface - MAX_GROUND_DEPTH;
-    let mut first_free_y = v.min_y;
-    for s in 0..v.height / 16 {
-        let (lo, hi) = (v.min_y + s * 16, v.min_y + s * 16 + 15);
-        if hi >= rock_top {
-            break;
-        }
-        if lo >= v.min_y + BEDROCK_LAYERS && hi <= 0 {
-            chunk.fill_block_state_section(s as u32, BlockState::DEEPSLATE);
-        } else if lo >= DEEPSLATE_TOP {
-            chunk.fill_block_state_section(s as u32, BlockState::STONE);
-        } else {
-            for (lx, lz, x, z) in ctx.each_column() {
-                for y in lo..=hi {
-                    chunk.set_block_state(lx, (y - v.min_y) as u32, lz, rock_at(seed, v.min_y, x, y, z));
-                }
-            }
-        }
-        first_free_y = hi + 1;
-    }
-    // Then layer by layer up to the highest ground: a layer clear of both ragged boundaries
-    // is stone in every column whose ground reaches it (written along the layer, not up each
-    // column, which strides through memory).
     let surface: Vec<i32> = ctx.each_column().map(|(_, _, x, z)| columns.surface_y(x, z)).collect();
+    let lowest = surface.iter().copied().min().unwrap_or(v.min_y);
     let top = surface.iter().copied().max().unwrap_or(v.min_y);
-    for y in first_free_y..=top {
+    // Layer by layer, written along the layer (up a column strides through memory). Layers
+    // clear of both ragged boundaries are one block: whole below the lowest ground, else in
+    // the columns whose ground reaches them; the others are drawn block by block.
+    for y in v.min_y..=top {
         let ly = (y - v.min_y) as u32;
-        if y >= DEEPSLATE_TOP && y - v.min_y >= BEDROCK_LAYERS {
-            for (block, &ground) in chunk.layer_mut(ly).iter_mut().zip(&surface) {
-                if y <= ground {
-                    *block = BlockState::STONE;
+        let clear_of_bedrock = y - v.min_y >= BEDROCK_LAYERS;
+        let one = if clear_of_bedrock && y <= 0 {
+            Some(BlockState::DEEPSLATE)
+        } else if clear_of_bedrock && y >= DEEPSLATE_TOP {
+            Some(BlockState::STONE)
+        } else {
+            None
+        };
+        match one {
+            Some(block) if y <= lowest => chunk.layer_mut(ly).fill(block),
+            Some(block) => {
+                for (b, &ground) in chunk.layer_mut(ly).iter_mut().zip(&surface) {
+                    if y <= ground {
+                        *b = block;
+                    }
                 }
             }
-        } else {
-            for ((lx, lz, x, z), &ground) in ctx.each_column().zip(&surface) {
-                if y <= ground {
-                    chunk.set_block_state(lx, ly, lz, rock_at(seed, v.min_y, x, y, z));
+            None => {
+                for ((lx, lz, x, z), &ground) in ctx.each_column().zip(&surface) {
+                    if y <= ground {
+                        chunk.set_block_state(lx, ly, lz, rock_at(seed, v.min_y, x, y, z));
+                    }
                 }
             }
         }

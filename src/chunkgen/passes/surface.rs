@@ -11,7 +11,6 @@ use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::surface::terracotta_band;
 use crate::chunkgen::ChunkContext;
 
-use super::rock::MAX_GROUND_DEPTH;
 
 /// Replaces the top of every column's rock with its ground: the top block, then the filler
 /// (or terracotta bands) below it. The bedrock floor stays.
@@ -24,8 +23,6 @@ pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
         let cell = ((lz as i64 / CELL) * 4 + lx as i64 / CELL) as usize;
         let ground = ctx.generator.ground_at(ctx.rules, columns, ctx.biomes[cell * cells_y + cell_y], x, z);
         let mouth = cave_field::may_open(ctx.seed(), columns, x, z);
-        // The rock pass filled whole sections only this far below the lowest ground.
-        debug_assert!(ground.filler_depth < MAX_GROUND_DEPTH);
         for y in (surface_y - ground.filler_depth).max(v.min_y + 1)..=surface_y {
             let block = if y == surface_y {
                 ground.top
