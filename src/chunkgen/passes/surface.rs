@@ -11,7 +11,6 @@ use crate::chunkgen::cells::{self, CELL};
 use crate::chunkgen::surface::terracotta_band;
 use crate::chunkgen::ChunkContext;
 
-
 /// Replaces the top of every column's rock with its ground: the top block, then the filler
 /// (or terracotta bands) below it. The bedrock floor stays.
 pub fn run(ctx: &mut ChunkContext, chunk: &mut Blocks) {
