@@ -148,17 +148,7 @@ pub fn sin_cos_turns(t: f64) -> (f64, f64) {
     let r = t - ((t + 1024.5) as i32 - 1024) as f64;
     let quarter = (4.0 * r + 4.5) as i32 - 4;
     let a = TAU * (r - 0.25 * quarter as f64);
-    let a2 = a * a;
-    let sin = a
-        * (1.0
-            + a2 * (-1.0 / 6.0
-                + a2 * (1.0 / 120.0
-                    + a2 * (-1.0 / 5040.0
-                        + a2 * (1.0 / 362_880.0 + a2 * (-1.0 / 39_916_800.0 + a2 / 6_227_020_800.0))))));
-    let cos = 1.0
-        + a2 * (-0.5
-            + a2 * (1.0 / 24.0
-                + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0 + a2 * (-1.0 / 3_628_800.0 + a2 / 479_001_600.0)))));
+    let (sin, cos) = taylor_sin_cos(a);
     // Back to the quarter-turn, without branches (the quarter is random to a branch
     // predictor, which made a `match` as slow as libm): odd quarters swap sine and cosine,
     // quarters 2 and 3 negate the sine, 1 and 2 the cosine.
@@ -181,6 +171,20 @@ pub fn sin_cos_turns_by_floor(t: f64) -> (f64, f64) {
     let r = t - ((t + 1024.5).floor() - 1024.0);
     let quarter = (4.0 * r + 4.5).floor() - 4.0;
     let a = TAU * (r - 0.25 * quarter);
+    let (sin, cos) = taylor_sin_cos(a);
+    // The quarter is −2 … 2; as `sin_cos_turns`'s `quarter & 3`: odd quarters swap sine and
+    // cosine, 2 and 3 (−2, −1, 2 here) negate the sine, 1 and 2 (1, 2, −2) the cosine.
+    let odd = quarter == 1.0 || quarter == -1.0;
+    let (s, c) = if odd { (cos, sin) } else { (sin, cos) };
+    let s = if quarter == 2.0 || quarter == -2.0 || quarter == -1.0 { -s } else { s };
+    let c = if quarter == 1.0 || quarter == 2.0 || quarter == -2.0 { -c } else { c };
+    (s, c)
+}
+
+/// Sine and cosine of `a` radians (|a| ≤ π/4) by their Taylor series to degree 13 and 12:
+/// the one polynomial both [`sin_cos_turns`] and [`sin_cos_turns_by_floor`] evaluate.
+#[inline(always)]
+fn taylor_sin_cos(a: f64) -> (f64, f64) {
     let a2 = a * a;
     let sin = a
         * (1.0
@@ -192,13 +196,7 @@ pub fn sin_cos_turns_by_floor(t: f64) -> (f64, f64) {
         + a2 * (-0.5
             + a2 * (1.0 / 24.0
                 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0 + a2 * (-1.0 / 3_628_800.0 + a2 / 479_001_600.0)))));
-    // The quarter is −2 … 2; as `sin_cos_turns`'s `quarter & 3`: odd quarters swap sine and
-    // cosine, 2 and 3 (−2, −1, 2 here) negate the sine, 1 and 2 (1, 2, −2) the cosine.
-    let odd = quarter == 1.0 || quarter == -1.0;
-    let (s, c) = if odd { (cos, sin) } else { (sin, cos) };
-    let s = if quarter == 2.0 || quarter == -2.0 || quarter == -1.0 { -s } else { s };
-    let c = if quarter == 1.0 || quarter == 2.0 || quarter == -2.0 { -c } else { c };
-    (s, c)
+    (sin, cos)
 }
 
 /// The largest whole number at most `v`, by conversion (`f64::floor` is a libm call on the
