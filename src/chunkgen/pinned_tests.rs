@@ -122,10 +122,12 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 /// again for acacias that bend and 2×2 dark oaks (trees reach 4 blocks from their trunk), and
 /// again when vegetation became data (`biomes/vegetation.toml`: sixteen species by weight,
 /// every plant by name) and warm seas grew coral, and again when the water's plants
-/// followed the biomes' tables instead of the temperature, and for huge mushrooms.
-const OUTSIDE_SHALLOWS_HASH: u64 = 0xc63c_db0d_dc90_81bb;
+/// followed the biomes' tables instead of the temperature, and for huge mushrooms, and again
+/// when gentle land's erosion octaves fell off faster (`erosion::GENTLE_SLOPE`; the learned
+/// mountains below, all steeper, held).
+const OUTSIDE_SHALLOWS_HASH: u64 = 0xf44b_2a3d_69b1_419f;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded as above.
-const PROCEDURAL_HASH: u64 = 0xe2bd_efbe_39a6_d8a1;
+const PROCEDURAL_HASH: u64 = 0xe974_f7d6_e606_f6ad;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core; re-recorded when the core's windows went from a half
 /// overlap to a quarter (stride 32 → 48).

@@ -89,8 +89,9 @@ pub struct ExportArgs {
     /// `block`: one value per block column; `model`: one per model pixel (4×4 blocks).
     #[arg(long, default_value = "block")]
     pub grid: Grid,
-    /// What to write: elevation (metres), water-level (river and lake surface, metres, NaN
-    /// where none) or discharge (m³/s); the water ones on the block grid.
+    /// What to write: elevation (ground, metres), water-level (river and lake surface,
+    /// metres, NaN where none), discharge (m³/s) or surface (what a DEM records: the water
+    /// surface where there is water, the ground elsewhere); all but elevation on the block grid.
     #[arg(long, value_enum, default_value_t = Quantity::Elevation)]
     pub quantity: Quantity,
     /// Output `.npy` (a `.json` with the same stem is written beside it).

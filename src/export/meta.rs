@@ -64,16 +64,29 @@ pub enum Quantity {
     /// Discharge of the river or lake over the column, m³/s, 0 elsewhere: upstream area
     /// weighted by runoff (block grid only).
     Discharge,
+    /// The surface a real DEM records, metres: the water surface over rivers, lakes and the
+    /// sea, the ground elsewhere (block grid only). Radar and laser DEMs (SRTM, whose water
+    /// bodies were also flattened to their shore level) see water, not river beds, so this is
+    /// what generated terrain is judged on against them.
+    Surface,
 }
 
 impl Quantity {
-    /// The pipeline channel holding it.
-    pub fn channel(self) -> usize {
+    /// Its values over a tile of the pipeline's channels, row-major.
+    pub fn values(self, tile: &crate::terrain::Tile) -> Vec<f32> {
         use crate::terrain::pipeline::channel;
+        let plain = |c: usize| tile.channel(c).to_vec();
         match self {
-            Quantity::Elevation => channel::ELEVATION,
-            Quantity::WaterLevel => channel::WATER_LEVEL,
-            Quantity::Discharge => channel::DISCHARGE,
+            Quantity::Elevation => plain(channel::ELEVATION),
+            Quantity::WaterLevel => plain(channel::WATER_LEVEL),
+            Quantity::Discharge => plain(channel::DISCHARGE),
+            Quantity::Surface => tile
+                .channel(channel::ELEVATION)
+                .iter()
+                .zip(tile.channel(channel::WATER_LEVEL))
+                // NaN water (none there) loses to the ground in `max`.
+                .map(|(&ground, &water)| ground.max(water))
+                .collect(),
         }
     }
 }

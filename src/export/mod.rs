@@ -151,7 +151,7 @@ pub fn export(
         (Grid::Block, _) => pipeline.columns(r),
         (Grid::Model, _) => pipeline.elevation(r),
     };
-    let (min, max) = write_array(out, rect, req.quantity.channel(), &mut query, progress)?;
+    let (min, max) = write_array(out, rect, req.quantity, &mut query, progress)?;
 
     let cell = req.grid.blocks_per_cell();
     let meta = ExportMeta {
@@ -184,12 +184,12 @@ fn cells(req: &ExportRequest) -> Result<Rect, ExportError> {
     Ok(Rect::new(z0, x0, z1 - z0 + 1, x1 - x0 + 1))
 }
 
-/// Streams `channel` of `rect` from `query` into the `.npy` at `path` in strips of rows;
+/// Streams `quantity` over `rect` from `query` into the `.npy` at `path` in strips of rows;
 /// returns (min, max), NaN ignored.
 fn write_array(
     path: &Path,
     rect: Rect,
-    channel: usize,
+    quantity: Quantity,
     query: &mut dyn FnMut(Rect) -> Tile,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(f32, f32), ExportError> {
@@ -205,12 +205,12 @@ fn write_array(
     while y < rect.y1() {
         let rows = strip_rows.min(rect.y1() - y);
         let tile = query(Rect::new(y, rect.x0, rows, rect.w));
-        let values = tile.channel(channel);
+        let values = quantity.values(&tile);
         for &v in values.iter().filter(|v| !v.is_nan()) {
             min = min.min(v);
             max = max.max(v);
         }
-        writer.write(values).map_err(write_err)?;
+        writer.write(&values).map_err(write_err)?;
         y += rows;
         progress((y - rect.y0) as u64, rect.h as u64);
     }

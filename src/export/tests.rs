@@ -45,9 +45,7 @@ fn streaming_in_strips_writes_every_row_in_order() {
         t
     };
     let mut last = (0, 0);
-    let (min, max) =
-        write_array(&path, rect, crate::terrain::pipeline::channel::ELEVATION, &mut query, &mut |d, t| last = (d, t))
-            .unwrap();
+    let (min, max) = write_array(&path, rect, Quantity::Elevation, &mut query, &mut |d, t| last = (d, t)).unwrap();
     assert_eq!(queries, 7, "one row per strip at this width");
     assert_eq!(last, (7, 7));
     assert_eq!((min, max), (-30.0, 36.0));
@@ -136,4 +134,43 @@ fn water_quantities_are_block_grid_only_and_say_what_they_are() {
     let values = read_npy_f32(&out).unwrap().1;
     let columns = pipeline.columns(Rect::new(21, -37, 30, 50));
     assert_eq!(values, columns.channel(channel::DISCHARGE));
+}
+
+#[test]
+fn the_surface_is_the_water_where_there_is_water_and_the_ground_elsewhere() {
+    let pipeline = Pipeline::new(3, &TerrainSettings::default());
+    // A stretch of the world with both wet and dry columns (the first coast or river found
+    // walking east), so that both halves of the rule are exercised.
+    let rect = (0..64)
+        .map(|i| Rect::new(0, i * 256, 32, 256))
+        .find(|&r| {
+            let water = pipeline.columns(r).channel(channel::WATER_LEVEL).to_vec();
+            water.iter().any(|w| w.is_nan()) && water.iter().any(|w| !w.is_nan())
+        })
+        .expect("a stretch with water and dry land within 16,384 blocks");
+    let dir = tempfile::tempdir().unwrap();
+    let vertical = Vertical { sea_level_y: 63, metres_per_block: 25.0 };
+    let out = dir.path().join("surface.npy");
+    let req = ExportRequest {
+        x0: rect.x0,
+        z0: rect.y0,
+        width: rect.w,
+        height: rect.h,
+        grid: Grid::Block,
+        quantity: Quantity::Surface,
+    };
+    export(&pipeline, &req, &vertical, &out, &mut |_, _| {}).unwrap();
+    let surface = read_npy_f32(&out).unwrap().1;
+    let columns = pipeline.columns(rect);
+    let (ground, water) = (columns.channel(channel::ELEVATION), columns.channel(channel::WATER_LEVEL));
+    let mut wet_below = 0;
+    for i in 0..surface.len() {
+        if water[i].is_nan() {
+            assert_eq!(surface[i], ground[i], "dry column {i}: the ground");
+        } else {
+            assert_eq!(surface[i], water[i].max(ground[i]), "wet column {i}: the water surface");
+            wet_below += usize::from(ground[i] < water[i]);
+        }
+    }
+    assert!(wet_below > 0, "some water stands over lower ground, so the surface differs from the ground");
 }

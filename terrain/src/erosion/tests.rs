@@ -79,7 +79,7 @@ fn the_carving_is_continuous_across_every_octave_s_lattice_lines() {
     let (slope, gradient) = (0.3, (0.2, -0.2));
     for k in 0..6 {
         let lambda = wavelength(k);
-        let amp = amplitude(lambda, slope);
+        let amp = amplitude(k, slope);
         // A point given in the octave's (turned) lattice frame, in world metres.
         let (sin, cos) = (f64::from(k) * GOLDEN_ANGLE + LATTICE_ANGLE).sin_cos();
         let world = |a: f64, b: f64| ((cos * a + sin * b) * lambda, (-sin * a + cos * b) * lambda);
@@ -189,4 +189,42 @@ fn the_vectorised_gullies_are_the_gathered_ones_bit_for_bit() {
         let any = gullies_with(&points, fx, fz, dir, sin_cos_turns);
         assert_eq!((any.value.to_bits(), any.dx.to_bits()), (a.value.to_bits(), a.dx.to_bits()));
     }
+}
+
+#[test]
+fn gentle_land_falls_off_faster_below_the_pivot_and_steep_land_keeps_the_hurst_law() {
+    let plain = |k: u32, slope: f64| AMPLITUDE * steepness(slope) * octave_scale(wavelength(k));
+    // Steep land: exactly the one-exponent law (multiplying by 1 changes no bit).
+    for slope in [GENTLE_SLOPE, 0.1, 0.6] {
+        assert_eq!(gentle_tilt(slope), 1.0);
+        for k in 0..MAX_OCTAVES {
+            assert_eq!(amplitude(k, slope), plain(k, slope));
+        }
+    }
+    // Flat land: the pivot octave as before, longer ones larger, shorter ones smaller, by
+    // 2^(−extra) per octave from the pivot.
+    let flat = 0.01;
+    let extra = GENTLE_EXTRA_HURST * (1.0 - flat / GENTLE_SLOPE);
+    assert!((amplitude(GENTLE_PIVOT, flat) / plain(GENTLE_PIVOT, flat) - 1.0).abs() < 1e-12);
+    for k in 0..MAX_OCTAVES {
+        let ratio = amplitude(k, flat) / plain(k, flat);
+        let expected = 2f64.powf(-extra * (f64::from(k) - f64::from(GENTLE_PIVOT)));
+        assert!((ratio / expected - 1.0).abs() < 1e-9, "octave {k}: {ratio} against {expected}");
+    }
+    // No jump in the amplitudes where the extra fades out.
+    let near = |d: f64| amplitude(6, GENTLE_SLOPE + d) / plain(6, GENTLE_SLOPE + d);
+    assert!((near(-1e-9) - near(1e-9)).abs() < 1e-8);
+    // And the filter carves with them: one octave alone is its amplitude times the same
+    // gully noise (the downhill direction is the same), so the heights scale as they do.
+    let f = ErosionFilter::new(9);
+    let k = GENTLE_PIVOT + 1;
+    for i in 0..50 {
+        let (x, z) = (f64::from(i) * 37.0, f64::from(i) * -41.0);
+        let (low, high) =
+            (f.apply(x, z, flat, (flat, 0.0), k..k + 1).height, f.apply(x, z, 0.1, (0.1, 0.0), k..k + 1).height);
+        if high.abs() > 1e-6 {
+            assert!((low / high / (amplitude(k, flat) / amplitude(k, 0.1)) - 1.0).abs() < 1e-9, "{low} {high}");
+        }
+    }
+    assert!(amplitude(k, flat) > MIN_AMPLITUDE_M, "the octave is carved at all");
 }
