@@ -41,6 +41,9 @@ pub struct Regions {
     pub heldout: Vec<u64>,
     /// One key per training tile, in the split's order.
     pub train: Vec<u64>,
+    /// Each tile's (row, column) in the set's tile grid: held-out tiles, then training tiles,
+    /// in the splits' order (as [`Regions::pooled`]).
+    pub cells: Vec<(i64, i64)>,
 }
 
 impl Regions {
@@ -52,21 +55,30 @@ impl Regions {
         let bad = |why: String| EvalError::Input(format!("{}: {why}", path.display()));
         let manifest: SetManifest =
             serde_json::from_str(&text).map_err(|e| bad(format!("not a prepared set's manifest: {e}")))?;
-        let keys = |split: &str, count: usize| -> Result<Vec<u64>, EvalError> {
-            let mut keys = vec![None; count];
+        let cells = |split: &str, count: usize| -> Result<Vec<(i64, i64)>, EvalError> {
+            let mut cells = vec![None; count];
             for t in manifest.tiles.iter().filter(|t| t.split == split) {
-                let square = (t.row.div_euclid(REGION_SQUARE_TILES), t.col.div_euclid(REGION_SQUARE_TILES));
-                let slot = keys.get_mut(t.index).ok_or_else(|| {
+                let slot = cells.get_mut(t.index).ok_or_else(|| {
                     bad(format!("{split} tile index {} is beyond the split's {count} tiles", t.index))
                 })?;
-                *slot = Some(((square.0 as u64) << 32) ^ (square.1 as u32 as u64));
+                *slot = Some((t.row, t.col));
             }
-            keys.into_iter()
+            cells
+                .into_iter()
                 .enumerate()
                 .map(|(i, k)| k.ok_or_else(|| bad(format!("lists no {split} tile with index {i}"))))
                 .collect()
         };
-        Ok(Some(Regions { heldout: keys("heldout", counts.0)?, train: keys("train", counts.1)? }))
+        let (heldout, train) = (cells("heldout", counts.0)?, cells("train", counts.1)?);
+        let square = |&(row, col): &(i64, i64)| {
+            let (y, x) = (row.div_euclid(REGION_SQUARE_TILES), col.div_euclid(REGION_SQUARE_TILES));
+            ((y as u64) << 32) ^ (x as u32 as u64)
+        };
+        Ok(Some(Regions {
+            heldout: heldout.iter().map(square).collect(),
+            train: train.iter().map(square).collect(),
+            cells: heldout.into_iter().chain(train).collect(),
+        }))
     }
 
     /// The keys of held-out then training tiles, as the real-vs-real splits pool them.

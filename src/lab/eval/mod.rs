@@ -9,6 +9,7 @@
 
 mod input;
 mod measure;
+mod places;
 mod report;
 
 use std::path::{Path, PathBuf};
@@ -16,9 +17,10 @@ use std::path::{Path, PathBuf};
 use image::Rgb;
 
 pub use input::{Heightmap, Reference};
+pub use places::PlaceFloor;
 pub use report::{BetaSplits, Report, Target, SPECTRAL_SLOPE_KEY};
 
-use crate::terrain::metrics::{fbm, Raster, SeamLines, FBM_BETA};
+use crate::terrain::metrics::{fbm, slope_degrees, wasserstein1, Raster, SeamLines, FBM_BETA};
 use crate::terrain::pipeline::BASE_METRES;
 use report::Column;
 
@@ -155,7 +157,13 @@ pub fn run(args: &EvalOptions, progress: &mut dyn FnMut(u64, u64)) -> Result<Rep
     let notes = notes(args, &reference, &generated, gen_tiles.len(), stride_metres);
     let regions = reference.regions.as_ref().map(|r| r.pooled());
     let caption = format!("lines every {:.0} km", stride_metres / 1000.0);
-    let table = Report::new(notes, &columns, &caption, regions.as_deref());
+    let mut table = Report::new(notes, &columns, &caption, regions.as_deref());
+    // Real places against each other (both splits: the tiles' grid says where they lie).
+    if let (Some(r), [real, generated, _, train]) = (&reference.regions, &columns[..]) {
+        let slopes: Vec<Vec<f32>> = ref_tiles.iter().chain(&train_tiles).map(slope_degrees).collect();
+        let to_real = |c: &Column| wasserstein1(&c.metrics.slopes, &real.metrics.slopes);
+        table.places = places::place_floor(&slopes, &r.cells, to_real(generated), to_real(train));
+    }
     let mut panels = vec![report::slope_panel(&columns), report::spectrum_panel(&columns)];
     panels.extend(table.beta_splits.as_ref().map(report::beta_split_panel));
     let image = crate::draw::chart::draw(&table.notes, &panels);

@@ -6,6 +6,7 @@ use image::Rgb;
 
 use super::input::REGION_SQUARE_TILES;
 use super::measure::SetMetrics;
+use super::places::PlaceFloor;
 use crate::draw::chart::{Panel, Series};
 use crate::terrain::metrics::{chi2_distance, histogram, quantile_edges, real_split_distances, wasserstein1};
 
@@ -41,6 +42,9 @@ pub struct Report {
     pub real_land: Vec<Target>,
     /// How far apart in β random sets of real tiles lie, when the floor is known.
     pub beta_splits: Option<BetaSplits>,
+    /// How far apart the quarters of the real landscape lie in slope distribution, when the
+    /// reference says where its tiles lie.
+    pub places: Option<PlaceFloor>,
 }
 
 /// The spectral-slope distance between real sets by the choice of tiles alone
@@ -252,7 +256,7 @@ impl Report {
             _ => (Vec::new(), Vec::new(), None),
         };
         let labels = columns.iter().map(|c| c.label.clone()).collect();
-        Report { notes, columns: labels, rows, targets, real_land, beta_splits }
+        Report { notes, columns: labels, rows, targets, real_land, beta_splits, places: None }
     }
 
     /// The cell of `metric` in column `column`, if both exist (for tests and scripts).
@@ -329,6 +333,23 @@ impl fmt::Display for Report {
                 100.0 * b.within_line,
                 b.generated,
                 100.0 * b.farther_than_generated
+            )?;
+        }
+        if let Some(p) = &self.places {
+            let tiles: Vec<String> = p.tiles.iter().map(usize::to_string).collect();
+            let distances: Vec<String> = p.distances.iter().map(|d| format!("{d:.2}")).collect();
+            writeln!(
+                f,
+                "slope W1 between real places: the real tiles in the quarters of their grid ({} tiles), each \
+                 against the other quarters: {}° (median {:.2}°; held-out to train, squares interleaved: {:.2}°); \
+                 generated to the reference {:.2}° = {:.1}× the median place: {} (≤ 2×)",
+                tiles.join(", "),
+                distances.join(", "),
+                p.median(),
+                p.floor,
+                p.generated,
+                p.generated / p.median(),
+                if p.met() { "met" } else { "NOT met" }
             )?;
         }
         Ok(())

@@ -210,6 +210,7 @@ fn a_single_reference_file_has_no_train_column() {
     let report =
         run(&args(&generated, &dir.path().join("ref.npy"), &dir.path().join("r.png")), &mut |_, _| {}).unwrap();
     assert_eq!(report.columns, ["reference", "generated", "fBm"]);
+    assert!(report.places.is_none(), "one file says nothing of where its tiles lie");
 }
 
 #[test]
@@ -274,6 +275,12 @@ fn a_prepared_sets_manifest_places_its_tiles_and_the_real_splits_deal_whole_squa
     let report = run(&args(&generated, &set, &dir.path().join("a.png")), &mut |_, _| {}).unwrap();
     assert!(report.beta_splits.as_ref().is_some_and(|b| b.by_region), "{report}");
     assert!(report.to_string().contains("whole 2×2-tile squares"), "{report}");
+    // Real places: rows and columns 0…3 split at 2; the south-west quarter holds no tile.
+    let places = report.places.as_ref().expect("the manifest places the tiles");
+    assert_eq!(places.tiles, vec![2, 1, 3], "{places:?}");
+    assert_eq!(places.distances.len(), 3);
+    assert!(places.distances.iter().all(|d| d.is_finite() && *d > 0.0), "{places:?}");
+    assert!(report.to_string().contains("slope W1 between real places"), "{report}");
 
     // A manifest that misplaces a tile is an input error naming it.
     let tiles = vec![entry("heldout", 7, 2, 2)];
