@@ -124,15 +124,16 @@ const PROCEDURAL_REGIONS: [(i32, i32); 3] = [(0, -94), (43, 7), (-150, 225)];
 /// every plant by name) and warm seas grew coral, and again when the water's plants
 /// followed the biomes' tables instead of the temperature, and for huge mushrooms, and again
 /// when gentle land's erosion octaves fell off faster (`erosion::GENTLE_SLOPE`; the learned
-/// mountains below, all steeper, held).
-const OUTSIDE_SHALLOWS_HASH: u64 = 0xf44b_2a3d_69b1_419f;
+/// mountains below, all steeper, held), and again when river courses began to wind between
+/// their nodes (`hydrology::rivers::MEANDER`).
+const OUTSIDE_SHALLOWS_HASH: u64 = 0x88af_4cf9_ada1_ba8a;
 /// [`hash_region`] of every column of [`PROCEDURAL_REGIONS`], re-recorded as above.
-const PROCEDURAL_HASH: u64 = 0xe974_f7d6_e606_f6ad;
+const PROCEDURAL_HASH: u64 = 0xc682_dad8_e070_53ac;
 /// [`hash_region`] of the first 2×2 chunks of the mountain region of [`PROCEDURAL_REGIONS`]
 /// with the shipped learned core; re-recorded when the core's windows went from a half
-/// overlap to a quarter (stride 32 → 48).
+/// overlap to a quarter (stride 32 → 48), and when river courses began to wind.
 #[cfg(feature = "learned")]
-const LEARNED_HASH: u64 = 0xb252_04fe_98f3_8d00;
+const LEARNED_HASH: u64 = 0x6e42_02e0_1e55_fe57;
 
 fn procedural_hash(mask: Option<i64>) -> (u64, usize) {
     let config = Config::default();

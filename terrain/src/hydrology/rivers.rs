@@ -6,7 +6,7 @@ use std::sync::Arc;
 use super::drainage::{Kind, D8, NO_DOWN};
 use super::{grid, CELL_METRES};
 use crate::infinite::Source;
-use crate::noise::{gradient, hash3};
+use crate::noise::{gradient, hash3, sin_cos_turns};
 use crate::tile::{Rect, Tile};
 
 /// Discharge (m³/s) from which a cell's water is a river a player sees: a stream of a few
@@ -25,6 +25,12 @@ const MAX_WIDTH_M: f64 = 1200.0;
 const JITTER: f64 = 0.3;
 /// Straight pieces each course curve is drawn with.
 const SEGMENTS: usize = 8;
+/// How far a course bends off its curve between two nodes, as a fraction of the curve's
+/// chord (either side, at most 32/27 times this): a curve through nodes 1 km apart alone runs
+/// straight for kilometres where several cells drain one way, and real rivers wind below
+/// that scale. The bend is zero, and flat, at both ends of a curve, so courses still join
+/// smoothly at every node and the network's cells decide where a river goes.
+const MEANDER: f64 = 0.18;
 /// Slope of a valley's sides above the floodplain (m/m): the valley a river cuts widens as
 /// it deepens into higher ground.
 const VALLEY_SLOPE: f64 = 0.2;
@@ -110,16 +116,30 @@ struct Piece {
 
 impl Piece {
     /// A quadratic Bézier from `a` via `b` to `c` (each x, z, discharge, level, width
-    /// factor): discharge and width factor linear along it, the level a Bézier too (so it
-    /// never rises where the three levels fall).
-    fn new(a: [f64; 5], b: [f64; 5], c: [f64; 5], block_m: f64) -> Piece {
+    /// factor), bent sideways by `bend` (two numbers in [−1, 1], see [`meander`]):
+    /// discharge and width factor linear along it, the level a Bézier too (so it never rises
+    /// where the three levels fall).
+    fn new(a: [f64; 5], b: [f64; 5], c: [f64; 5], bend: (f64, f64), block_m: f64) -> Piece {
+        let length = |p: [f64; 5], q: [f64; 5]| ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt();
+        let (chord, path) = (length(a, c), length(a, b) + length(b, c));
+        // Sharp turns bend less: a bend as deep as the turn's radius would fold the course.
+        let straightness = if path > 0.0 { chord / path } else { 1.0 };
+        let amplitude = MEANDER * chord * straightness * straightness;
         let points: Vec<[f64; 5]> = (0..=SEGMENTS)
             .map(|k| {
                 let t = k as f64 / SEGMENTS as f64;
                 let (u, v, w) = ((1.0 - t) * (1.0 - t), 2.0 * t * (1.0 - t), t * t);
+                let (x, z) = (u * a[0] + v * b[0] + w * c[0], u * a[1] + v * b[1] + w * c[1]);
+                // Sideways: the unit normal of the curve's direction there.
+                let (dx, dz) = (
+                    2.0 * (1.0 - t) * (b[0] - a[0]) + 2.0 * t * (c[0] - b[0]),
+                    2.0 * (1.0 - t) * (b[1] - a[1]) + 2.0 * t * (c[1] - b[1]),
+                );
+                let norm = (dx * dx + dz * dz).sqrt();
+                let off = if norm > 0.0 { amplitude * meander(t, bend) / norm } else { 0.0 };
                 [
-                    u * a[0] + v * b[0] + w * c[0],
-                    u * a[1] + v * b[1] + w * c[1],
+                    x - off * dz,
+                    z + off * dx,
                     a[2] + t * (c[2] - a[2]),
                     u * a[3] + v * b[3] + w * c[3],
                     a[4] + t * (c[4] - a[4]),
@@ -163,6 +183,15 @@ impl Piece {
             && self.lo.1 - self.reach <= hi.1
             && self.hi.1 + self.reach >= lo.1
     }
+}
+
+/// The sideways bend of a course curve at `t` ∈ [0, 1], in units of its amplitude:
+/// `sin²(πt) · (p + q · cos(πt))` for `bend = (p, q)`, zero with a zero slope at both ends (so
+/// neighbouring curves join without a kink), one bow (`q` = 0) or an S (`p` = 0) between.
+/// Sine and cosine by [`sin_cos_turns`], the same bits on every platform.
+fn meander(t: f64, (p, q): (f64, f64)) -> f64 {
+    let (sin, cos) = sin_cos_turns(0.5 * t);
+    sin * sin * (p + q * cos)
 }
 
 /// Rivers and lakes of one world at the block grid.
@@ -220,6 +249,14 @@ impl Rivers {
         ((cx as f64 + 0.5 + u(h)) * CELL_METRES, (cy as f64 + 0.5 + u(h >> 16)) * CELL_METRES)
     }
 
+    /// How the course from cell `from` into cell `to` bends ([`meander`]): two numbers in
+    /// [−1, 1] of the world seed and the two cells alone, so every query draws it alike.
+    fn bend(&self, from: (i64, i64), to: (i64, i64)) -> (f64, f64) {
+        let h = hash3(hash3(self.seed ^ 0x4D45_414E, from.0, from.1), to.0, to.1);
+        let u = |bits: u64| (bits & 0xFFFF) as f64 / 65535.0 * 2.0 - 1.0;
+        (u(h), u(h >> 16))
+    }
+
     /// The network's cells (kind, discharge, level, downstream) over `cells`.
     pub fn network(&self, cells: Rect) -> Tile {
         self.network.query(cells)
@@ -259,7 +296,8 @@ impl Rivers {
                     let pu = self.node(uy, ux);
                     let s = mid(pu, pc);
                     let level = (cells.level(uy, ux).max(here) + here) / 2.0;
-                    out.push(Piece::new([s.0, s.1, cells.discharge(uy, ux), level, 1.0], centre, end, block_m));
+                    let bend = self.bend((uy, ux), (cy, cx));
+                    out.push(Piece::new([s.0, s.1, cells.discharge(uy, ux), level, 1.0], centre, end, bend, block_m));
                 }
                 if upstream == 0 {
                     // A source: the course starts at the node.
@@ -267,6 +305,7 @@ impl Rivers {
                         centre,
                         [(pc.0 + m.0) / 2.0, (pc.1 + m.1) / 2.0, q, (here + end[3]) / 2.0, 1.0],
                         end,
+                        self.bend((cy, cx), (cy, cx)),
                         block_m,
                     ));
                 }
@@ -277,6 +316,7 @@ impl Rivers {
                         end,
                         [(m.0 + pd.0) / 2.0, (m.1 + pd.1) / 2.0, q, (end[3] + there) / 2.0, 1.0],
                         last,
+                        self.bend((cy, cx), (dy, dx)),
                         block_m,
                     ));
                 }
@@ -304,7 +344,10 @@ impl Rivers {
     fn around(&self, blocks: Rect, block_m: f64) -> ((f64, f64), (f64, f64), Rect) {
         let lo = (blocks.x0 as f64 * block_m, blocks.y0 as f64 * block_m);
         let hi = (blocks.x1() as f64 * block_m, blocks.y1() as f64 * block_m);
-        let reach = MAX_WIDTH_M + VALLEY_REACH_M + CELL_METRES * (1.0 + JITTER);
+        // A curve's chord is under 2 (1 + JITTER) cells, and it bends off by at most 32/27
+        // MEANDER chords (`meander`'s largest value).
+        let bend = 1.2 * MEANDER * 2.0 * (1.0 + JITTER);
+        let reach = MAX_WIDTH_M + VALLEY_REACH_M + CELL_METRES * (1.0 + JITTER + bend);
         let cell = |m: f64| (m / CELL_METRES).floor() as i64;
         let (y0, x0) = (cell(lo.1 - reach), cell(lo.0 - reach));
         (lo, hi, Rect::new(y0, x0, cell(hi.1 + reach) - y0 + 1, cell(hi.0 + reach) - x0 + 1))
@@ -500,6 +543,39 @@ mod tests {
         // Never past the widest river, however large the flare.
         assert_eq!(flared_width_m(1e6, ESTUARY_FLARE, BLOCK_M), MAX_WIDTH_M);
         assert_eq!(flared_width_m(4.0, 1.0, BLOCK_M), water_width_m(4.0, BLOCK_M));
+    }
+
+    #[test]
+    fn a_course_bends_between_its_ends_and_joins_its_neighbours_without_a_kink() {
+        let at = |x: f64| [x, 0.0, 1.0, 10.0, 1.0];
+        let piece = |bend| Piece::new(at(0.0), at(500.0), at(1000.0), bend, BLOCK_M);
+        assert!(piece((0.0, 0.0)).points.iter().all(|q| q[1] == 0.0), "no bend: the Bézier itself");
+        let bow = piece((1.0, 0.0));
+        // A bow: the middle off by the full amplitude, the ends where they were.
+        let middle = bow.points[SEGMENTS / 2];
+        assert!((middle[1].abs() - MEANDER * 1000.0).abs() < 1e-6, "{middle:?}");
+        let (first, last) = (bow.points[0], bow.points[SEGMENTS]);
+        assert!(first[1].abs() < 1e-9 && last[1].abs() < 1e-9 && first[0] == 0.0 && (last[0] - 1000.0).abs() < 1e-9);
+        // An S: the two halves on opposite sides.
+        let s = piece((0.0, 1.0));
+        assert!(s.points[2][1] * s.points[SEGMENTS - 2][1] < 0.0, "{:?}", s.points);
+        // The bend's shape: zero and flat at both ends, never past 32/27.
+        for bend in [(1.0, 1.0), (-1.0, 1.0), (0.3, -0.8)] {
+            let slope = |t: f64| (meander(t + 1e-6, bend) - meander(t, bend)) / 1e-6;
+            assert!(meander(0.0, bend).abs() < 1e-12 && meander(1.0, bend).abs() < 1e-12);
+            assert!(slope(0.0).abs() < 1e-4 && slope(1.0 - 1e-6).abs() < 1e-4, "{bend:?}");
+            assert!((0..=1000).all(|k| meander(k as f64 / 1000.0, bend).abs() <= 32.0 / 27.0 + 1e-9));
+        }
+        // Level, discharge and width factor do not move with the bend.
+        assert!(bow.points.iter().zip(&piece((0.0, 0.0)).points).all(|(a, b)| a[2..] == b[2..]));
+    }
+
+    #[test]
+    fn a_winding_river_has_water_all_along_it() {
+        // Every 100 m from its second cell to its mouth, a cut across holds river water.
+        for x in (15..100).map(|i| i as f64 * 100.0) {
+            assert!(river_columns(&across(x)) > 0, "no river at x {x} m");
+        }
     }
 
     #[test]
