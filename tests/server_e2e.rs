@@ -575,13 +575,16 @@ fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_r
 }
 
 /// Two dry columns near `spawn` with nothing growing on them (a broken block must not leave
-/// a floating plant; a placed one needs a clear spot), a few blocks apart.
-/// A bare dry column (no plant, no tree over it) 2–3 blocks east of the spawn and one west, if
-/// there are.
+/// a floating plant; a placed one needs a clear spot), a few blocks apart: a bare dry column
+/// (no plant, no tree over it, no water beside it, where sugar cane may grow on the bank) 2–3
+/// blocks east of the spawn and one west, if there are.
 fn bare_columns(generator: &Generator, rules: &BiomeRules, spawn: (i64, i64)) -> Option<((i64, i64), (i64, i64))> {
     let v = *generator.vertical();
     let bare = |&(x, z): &(i64, i64)| {
         generator.surface(rules, x, z).y > v.water_top_y()
+            && [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .all(|&(dx, dz)| generator.surface(rules, x + dx, z + dz).water_y.is_none())
             && generator.plant_blocks(rules, x, z).is_empty()
             && generator.clear_of_trees(rules, x, z)
     };
