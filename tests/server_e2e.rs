@@ -581,8 +581,10 @@ fn console_pregen_starts_pauses_continues_cancels_finishes_and_resumes_after_a_r
 fn bare_columns(generator: &Generator, rules: &BiomeRules, spawn: (i64, i64)) -> Option<((i64, i64), (i64, i64))> {
     let v = *generator.vertical();
     let bare = |&(x, z): &(i64, i64)| {
-        generator.surface(rules, x, z).y > v.water_top_y()
-            && [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)]
+        let here = generator.surface(rules, x, z);
+        here.y > v.water_top_y()
+            && here.water_y.is_none()
+            && [(1, 0), (-1, 0), (0, 1), (0, -1)]
                 .iter()
                 .all(|&(dx, dz)| generator.surface(rules, x + dx, z + dz).water_y.is_none())
             && generator.plant_blocks(rules, x, z).is_empty()

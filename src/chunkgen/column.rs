@@ -21,8 +21,11 @@ use super::trees::{self, Tree};
 use super::{Generator, SurfaceSample};
 
 impl Generator {
-    /// The blocks of the plant on column (`x`, `z`), from the one above the ground upwards
-    /// (empty for bare ground), as [`chunk`](Self::chunk) places them where no tree stands.
+    /// The blocks of the land plant on column (`x`, `z`), from the one above the ground
+    /// upwards (empty for bare ground), as [`chunk`](Self::chunk) places them where no tree
+    /// stands. Plants of the water's edge (sugar cane on a bank, lily pads) are the aquatic
+    /// pass's, decided from the chunk's blocks, and not reported here: a column with water
+    /// beside it may hold sugar cane.
     pub fn plant_blocks(&self, rules: &BiomeRules, x: i64, z: i64) -> Vec<BlockState> {
         let columns = Columns::query(&self.pipeline, &self.vertical, tree_rect(x, z, 1));
         let biome = |x, z| self.surface_biome(rules, &columns, x, z);

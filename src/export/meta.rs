@@ -72,10 +72,11 @@ pub enum Quantity {
 }
 
 impl Quantity {
-    /// Its values over a tile of the pipeline's channels, row-major.
-    pub fn values(self, tile: &crate::terrain::Tile) -> Vec<f32> {
+    /// Its values over a tile of the pipeline's channels, row-major: a channel itself where
+    /// the quantity is one.
+    pub fn values(self, tile: &crate::terrain::Tile) -> std::borrow::Cow<'_, [f32]> {
         use crate::terrain::pipeline::channel;
-        let plain = |c: usize| tile.channel(c).to_vec();
+        let plain = |c: usize| std::borrow::Cow::Borrowed(tile.channel(c));
         match self {
             Quantity::Elevation => plain(channel::ELEVATION),
             Quantity::WaterLevel => plain(channel::WATER_LEVEL),
@@ -86,7 +87,8 @@ impl Quantity {
                 .zip(tile.channel(channel::WATER_LEVEL))
                 // NaN water (none there) loses to the ground in `max`.
                 .map(|(&ground, &water)| ground.max(water))
-                .collect(),
+                .collect::<Vec<f32>>()
+                .into(),
         }
     }
 }

@@ -18,9 +18,9 @@ use image::Rgb;
 
 pub use input::{Heightmap, Reference};
 pub use places::PlaceFloor;
-pub use report::{BetaSplits, Report, Target, SPECTRAL_SLOPE_KEY};
+pub use report::{BetaSplits, Report, Target, SLOPE_W1_KEY, SPECTRAL_SLOPE_KEY};
 
-use crate::terrain::metrics::{fbm, slope_degrees, wasserstein1, Raster, SeamLines, FBM_BETA};
+use crate::terrain::metrics::{fbm, slope_degrees, Raster, SeamLines, FBM_BETA};
 use crate::terrain::pipeline::BASE_METRES;
 use report::Column;
 
@@ -158,11 +158,14 @@ pub fn run(args: &EvalOptions, progress: &mut dyn FnMut(u64, u64)) -> Result<Rep
     let regions = reference.regions.as_ref().map(|r| r.pooled());
     let caption = format!("lines every {:.0} km", stride_metres / 1000.0);
     let mut table = Report::new(notes, &columns, &caption, regions.as_deref());
-    // Real places against each other (both splits: the tiles' grid says where they lie).
-    if let (Some(r), [real, generated, _, train]) = (&reference.regions, &columns[..]) {
+    // Real places against each other (both splits: the tiles' grid says where they lie),
+    // beside the bar's slope line for the generated terrain and for the training land.
+    let slope_line = |bar: &[Target]| bar.iter().find(|t| t.key == SLOPE_W1_KEY).map(|t| t.value);
+    if let (Some(r), Some(generated), Some(floor)) =
+        (&reference.regions, slope_line(&table.targets), slope_line(&table.real_land))
+    {
         let slopes: Vec<Vec<f32>> = ref_tiles.iter().chain(&train_tiles).map(slope_degrees).collect();
-        let to_real = |c: &Column| wasserstein1(&c.metrics.slopes, &real.metrics.slopes);
-        table.places = places::place_floor(&slopes, &r.cells, to_real(generated), to_real(train));
+        table.places = places::place_floor(&slopes, &r.cells, generated, floor);
     }
     let mut panels = vec![report::slope_panel(&columns), report::spectrum_panel(&columns)];
     panels.extend(table.beta_splits.as_ref().map(report::beta_split_panel));

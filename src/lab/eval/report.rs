@@ -16,6 +16,9 @@ pub const STYLE_BINS: usize = 20;
 /// Key of the realism bar's spectral-slope line.
 pub const SPECTRAL_SLOPE_KEY: &str = "spectral_slope_abs_delta";
 
+/// Key of the realism bar's slope-distribution line (W1, degrees).
+pub const SLOPE_W1_KEY: &str = "slope_w1_deg";
+
 /// One column of the report: a set of tiles and how it is drawn.
 pub struct Column {
     /// Header of the column.
@@ -150,7 +153,7 @@ fn bar([reference, generated, fbm, train]: [&SetMetrics; 4], slope_edges: &[f64]
     let relief_ref = histogram(&reference.relief, relief_edges);
     type Distance = fn(&SetMetrics, &SetMetrics, &[f64], &[f64], &[f64], &[f64]) -> f64;
     let metrics: [(&str, Distance); 5] = [
-        ("slope_w1_deg", |m, r, _, _, _, _| wasserstein1(&m.slopes, &r.slopes)),
+        (SLOPE_W1_KEY, |m, r, _, _, _, _| wasserstein1(&m.slopes, &r.slopes)),
         ("slope_chi2", |m, _, se, sr, _, _| chi2_distance(&histogram(&m.slopes, se), sr)),
         ("relative_elevation_w1_m", |m, r, _, _, _, _| wasserstein1(&m.relief, &r.relief)),
         ("relative_elevation_chi2", |m, _, _, _, re, rr| chi2_distance(&histogram(&m.relief, re), rr)),
