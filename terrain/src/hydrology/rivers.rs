@@ -155,25 +155,44 @@ impl Piece {
     /// Distance (metres) from (`x`, `z`) to the curve, and the discharge, level and width
     /// factor there.
     fn nearest(&self, x: f64, z: f64) -> (f64, f64, f64, f64) {
-        let mut best = (f64::INFINITY, 0.0, 0.0, 1.0);
-        for s in self.points.windows(2) {
+        // The offset from (x, z) to segment `s`'s nearest point, and where along it that is.
+        let offset = |s: &[[f64; 5]]| {
             let (p, q) = (s[0], s[1]);
             let (dx, dz) = (q[0] - p[0], q[1] - p[1]);
             let len2 = dx * dx + dz * dz;
             let t = if len2 > 0.0 { (((x - p[0]) * dx + (z - p[1]) * dz) / len2).clamp(0.0, 1.0) } else { 0.0 };
-            let (ex, ez) = (x - p[0] - t * dx, z - p[1] - t * dz);
-            // `hypot` is a libm call, and most segments lie farther than the nearest so far,
-            // which the square shows without it (the margin is far above its rounding, so
-            // the same segment wins either way).
-            if ex * ex + ez * ez > best.0 * best.0 * (1.0 + 1e-9) {
+            ((x - p[0] - t * dx, z - p[1] - t * dz), t)
+        };
+        // Two passes, so `hypot` (a libm call, and this loop's largest cost) runs about once per
+        // curve: the squares find the nearest, then only segments within their rounding of it
+        // are measured exactly. The first segment of least `hypot` wins, as a single pass
+        // keeping every strictly nearer segment would choose.
+        let near2 = self.points.windows(2).fold(f64::INFINITY, |m, s| {
+            let ((ex, ez), _) = offset(s);
+            m.min(ex * ex + ez * ez)
+        });
+        let mut best = (f64::INFINITY, 0.0, 0.0, 1.0);
+        for s in self.points.windows(2) {
+            let ((ex, ez), t) = offset(s);
+            if ex * ex + ez * ez > near2 * (1.0 + 1e-9) {
                 continue;
             }
             let d = ex.hypot(ez);
             if d < best.0 {
+                let (p, q) = (s[0], s[1]);
                 best = (d, p[2] + t * (q[2] - p[2]), p[3] + t * (q[3] - p[3]), p[4] + t * (q[4] - p[4]));
             }
         }
         best
+    }
+
+    /// False only where the curve's valley surely does not reach (`x`, `z`): outside its box
+    /// grown by the reach, with a margin far above the rounding of [`Piece::nearest`], so a
+    /// column it turns away would have been measured at least the reach away. A region's
+    /// columns each skip most of the region's curves on this test alone.
+    fn may_reach(&self, x: f64, z: f64) -> bool {
+        let r = self.reach * (1.0 + 1e-9) + 1e-6;
+        x >= self.lo.0 - r && x <= self.hi.0 + r && z >= self.lo.1 - r && z <= self.hi.1 + r
     }
 
     /// True when the curve's valley may reach the box [`lo`, `hi`] (metres).
@@ -384,6 +403,9 @@ impl Rivers {
                 let mut river: Option<(f64, f64, f64)> = None;
                 let mut bank = RIVER_DISTANCE_MAX_M;
                 for p in &pieces {
+                    if !p.may_reach(xm, zm) {
+                        continue;
+                    }
                     let (d, q, level, flare) = p.nearest(xm, zm);
                     if d >= p.reach {
                         continue;
@@ -568,6 +590,37 @@ mod tests {
         }
         // Level, discharge and width factor do not move with the bend.
         assert!(bow.points.iter().zip(&piece((0.0, 0.0)).points).all(|(a, b)| a[2..] == b[2..]));
+    }
+
+    #[test]
+    fn the_nearest_point_and_the_reach_test_agree_with_measuring_every_segment() {
+        // A winding curve; points on a grid around and beyond it, some on its nodes.
+        let piece = Piece::new(
+            [0.0, 0.0, 1.0, 10.0, 1.0],
+            [700.0, 400.0, 2.0, 9.0, 1.5],
+            [1000.0, 1000.0, 3.0, 8.0, 2.0],
+            (0.7, -0.4),
+            BLOCK_M,
+        );
+        for (i, j) in (-20..=60).flat_map(|i| (-20..=60).map(move |j| (i, j))) {
+            let (x, z) = (i as f64 * 25.0, j as f64 * 25.0);
+            // Every segment measured by `hypot`; the first of least distance wins.
+            let mut brute = (f64::INFINITY, 0.0, 0.0, 1.0);
+            for s in piece.points.windows(2) {
+                let (p, q) = (s[0], s[1]);
+                let (dx, dz) = (q[0] - p[0], q[1] - p[1]);
+                let t = (((x - p[0]) * dx + (z - p[1]) * dz) / (dx * dx + dz * dz)).clamp(0.0, 1.0);
+                let d = (x - p[0] - t * dx).hypot(z - p[1] - t * dz);
+                if d < brute.0 {
+                    brute = (d, p[2] + t * (q[2] - p[2]), p[3] + t * (q[3] - p[3]), p[4] + t * (q[4] - p[4]));
+                }
+            }
+            let near = piece.nearest(x, z);
+            assert_eq!(near, brute, "at ({x}, {z})");
+            assert!(piece.may_reach(x, z) || near.0 >= piece.reach, "({x}, {z}) is {} m away", near.0);
+        }
+        // The test turns columns away: far ones are not measured at all.
+        assert!(!piece.may_reach(-piece.reach - 1.0, 0.0) && piece.may_reach(-piece.reach + 1.0, 0.0));
     }
 
     #[test]
