@@ -187,11 +187,12 @@ impl Piece {
     }
 
     /// False only where the curve's valley surely does not reach (`x`, `z`): outside its box
-    /// grown by the reach, with a margin far above the rounding of [`Piece::nearest`], so a
-    /// column it turns away would have been measured at least the reach away. A region's
-    /// columns each skip most of the region's curves on this test alone.
+    /// grown by the reach and a millimetre — far above the rounding of [`Piece::nearest`]
+    /// even at the world border at 250 m per block (7.5·10⁹ m, where a metre's last bit is
+    /// 10⁻⁶) — so a column it turns away would have been measured at least the reach away.
+    /// A region's columns each skip most of the region's curves on this test alone.
     fn may_reach(&self, x: f64, z: f64) -> bool {
-        let r = self.reach * (1.0 + 1e-9) + 1e-6;
+        let r = self.reach + 1e-3;
         x >= self.lo.0 - r && x <= self.hi.0 + r && z >= self.lo.1 - r && z <= self.hi.1 + r
     }
 
