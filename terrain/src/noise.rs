@@ -116,21 +116,53 @@ pub fn hash3(seed: u64, a: i64, b: i64) -> u64 {
 pub fn gradient(seed: u64, y: f64, x: f64) -> f64 {
     let (cy, cx) = (floor(y), floor(x));
     let (fy, fx) = (y - cy, x - cx);
-    let (cy, cx) = (cy as i64, cx as i64);
-    let grad = |gy: i64, gx: i64, dy: f64, dx: f64| {
-        let h = hash3(seed, gy, gx);
-        let (sin, cos) = sin_cos_turns((h >> 11) as f64 / (1u64 << 53) as f64);
-        cos * dx + sin * dy
-    };
+    let [g00, g01, g10, g11] = corner_gradients(seed, cy as i64, cx as i64);
+    let grad = |(sin, cos): (f64, f64), dy: f64, dx: f64| cos * dx + sin * dy;
     let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
     let (u, v) = (fade(fx), fade(fy));
-    let n00 = grad(cy, cx, fy, fx);
-    let n01 = grad(cy, cx + 1, fy, fx - 1.0);
-    let n10 = grad(cy + 1, cx, fy - 1.0, fx);
-    let n11 = grad(cy + 1, cx + 1, fy - 1.0, fx - 1.0);
+    let n00 = grad(g00, fy, fx);
+    let n01 = grad(g01, fy, fx - 1.0);
+    let n10 = grad(g10, fy - 1.0, fx);
+    let n11 = grad(g11, fy - 1.0, fx - 1.0);
     let top = n00 + u * (n01 - n00);
     let bottom = n10 + u * (n11 - n10);
     (top + v * (bottom - top)) * std::f64::consts::SQRT_2
+}
+
+/// The (sin, cos) gradients at the corners (`cy`, `cx`), (`cy`, `cx` + 1), (`cy` + 1, `cx`)
+/// and (`cy` + 1, `cx` + 1) of a lattice cell of noise `seed`.
+///
+/// Remembered per thread: the layout samples its longest octaves many times per cell (a
+/// continent-scale octave spans thousands of its pixels), and the corners' hashes and sines
+/// were most of the layout's time. A small direct-mapped table keyed by (seed, cell), slot
+/// by seed so each octave keeps its own last cell; a hit returns exactly what is computed.
+fn corner_gradients(seed: u64, cy: i64, cx: i64) -> [(f64, f64); 4] {
+    let compute = || {
+        let at = |gy: i64, gx: i64| sin_cos_turns((hash3(seed, gy, gx) >> 11) as f64 / (1u64 << 53) as f64);
+        [at(cy, cx), at(cy, cx + 1), at(cy + 1, cx), at(cy + 1, cx + 1)]
+    };
+    CORNERS.with_borrow_mut(|table| {
+        let slot = &mut table[(seed >> (64 - CORNER_SLOTS.trailing_zeros())) as usize];
+        match slot {
+            Some((s, c, g)) if *s == seed && *c == (cy, cx) => *g,
+            _ => {
+                let g = compute();
+                *slot = Some((seed, (cy, cx), g));
+                g
+            }
+        }
+    })
+}
+
+/// Slots of [`corner_gradients`]' table (a power of two: the slot is the seed's top bits).
+const CORNER_SLOTS: usize = 128;
+
+type Corners = Option<(u64, (i64, i64), [(f64, f64); 4])>;
+
+thread_local! {
+    /// [`corner_gradients`]' table, one per thread.
+    static CORNERS: std::cell::RefCell<[Corners; CORNER_SLOTS]> =
+        const { std::cell::RefCell::new([None; CORNER_SLOTS]) };
 }
 
 /// (sin 2πt, cos 2πt) of `t` turns.
@@ -256,6 +288,42 @@ mod tests {
             let (a, b) = (sin_cos_turns(t), sin_cos_turns_by_floor(t));
             assert_eq!((a.0.to_bits(), a.1.to_bits()), (b.0.to_bits(), b.1.to_bits()), "t = {t:e}");
         }
+    }
+
+    #[test]
+    fn gradient_noise_is_the_same_whatever_the_table_remembers() {
+        // The formula without the table.
+        let direct = |seed: u64, y: f64, x: f64| {
+            let (cy, cx) = (floor(y), floor(x));
+            let (fy, fx) = (y - cy, x - cx);
+            let grad = |gy: i64, gx: i64, dy: f64, dx: f64| {
+                let (sin, cos) = sin_cos_turns((hash3(seed, gy, gx) >> 11) as f64 / (1u64 << 53) as f64);
+                cos * dx + sin * dy
+            };
+            let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+            let (u, v) = (fade(fx), fade(fy));
+            let (cy, cx) = (cy as i64, cx as i64);
+            let top = grad(cy, cx, fy, fx) + u * (grad(cy, cx + 1, fy, fx - 1.0) - grad(cy, cx, fy, fx));
+            let bottom = grad(cy + 1, cx, fy - 1.0, fx)
+                + u * (grad(cy + 1, cx + 1, fy - 1.0, fx - 1.0) - grad(cy + 1, cx, fy - 1.0, fx));
+            (top + v * (bottom - top)) * std::f64::consts::SQRT_2
+        };
+        // Seeds sharing a slot (same top bits) and seeds apart, interleaved; points walking
+        // through cells and back, so the table both hits and is evicted.
+        let seeds = [7u64, 7 | 1 << 40, u64::MAX, 0x0123_4567_89ab_cdef];
+        let points: Vec<(f64, f64)> =
+            (0..400).map(|i| (-3.3 + 0.037 * i as f64, 11.9 - 0.021 * (i % 97) as f64)).collect();
+        for round in 0..2 {
+            for (k, &(y, x)) in points.iter().enumerate() {
+                let seed = seeds[(k + round) % seeds.len()];
+                assert_eq!(gradient(seed, y, x).to_bits(), direct(seed, y, x).to_bits(), "seed {seed} at ({y}, {x})");
+            }
+        }
+        // On another thread, with a table of its own, the same bits.
+        let here: Vec<u64> = points.iter().map(|&(y, x)| gradient(7, y, x).to_bits()).collect();
+        let there =
+            std::thread::spawn(move || points.iter().map(|&(y, x)| gradient(7, y, x).to_bits()).collect::<Vec<_>>());
+        assert_eq!(here, there.join().unwrap());
     }
 
     #[test]
