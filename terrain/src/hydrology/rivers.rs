@@ -192,8 +192,8 @@ impl Piece {
     /// 10⁻⁶) — so a column it turns away would have been measured at least the reach away.
     /// A region's columns each skip most of the region's curves on this test alone.
     fn may_reach(&self, x: f64, z: f64) -> bool {
-        let r = self.reach + 1e-3;
-        x >= self.lo.0 - r && x <= self.hi.0 + r && z >= self.lo.1 - r && z <= self.hi.1 + r
+        const MARGIN_M: f64 = 1e-3;
+        self.touches((x - MARGIN_M, z - MARGIN_M), (x + MARGIN_M, z + MARGIN_M))
     }
 
     /// True when the curve's valley may reach the box [`lo`, `hi`] (metres).
